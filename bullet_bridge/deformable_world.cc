@@ -1,0 +1,91 @@
+#include "bullet_bridge/deformable_world.h"
+
+#include <BulletCollision/CollisionDispatch/btCollisionDispatcher.h>
+
+#include <algorithm>
+#include <chrono>
+
+#include "bullet_bridge/eigen_bullet.h"
+#include "plugin/tet_element_model.h"
+
+namespace taut {
+
+namespace {
+// Milliseconds since `start`.
+double MsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+}  // namespace
+
+DeformableWorld::DeformableWorld(btDispatcher* dispatcher, btBroadphaseInterface* broadphase,
+                                 btConstraintSolver* solver,
+                                 btCollisionConfiguration* configuration)
+    : btDiscreteDynamicsWorld(dispatcher, broadphase, solver, configuration) {
+  // Bullet must never build contact manifolds for deformables: taut detects those itself.
+  if (auto* collision_dispatcher = dynamic_cast<btCollisionDispatcher*>(dispatcher)) {
+    for (int type = 0; type < MAX_BROADPHASE_COLLISION_TYPES; ++type) {
+      collision_dispatcher->registerCollisionCreateFunc(kDeformableShapeType, type,
+                                                        &empty_algorithm_);
+      collision_dispatcher->registerCollisionCreateFunc(type, kDeformableShapeType,
+                                                        &empty_algorithm_);
+    }
+  }
+}
+
+DeformableWorld::~DeformableWorld() {
+  for (auto& body : bodies_) removeCollisionObject(&body->collision_object());
+}
+
+DeformableBody* DeformableWorld::AddTetBody(const TetMesh& mesh,
+                                            const DeformableBodySettings& settings) {
+  return AddTetBody(std::make_shared<const TetMesh>(mesh), settings);
+}
+
+DeformableBody* DeformableWorld::AddTetBody(std::shared_ptr<const TetMesh> mesh,
+                                            const DeformableBodySettings& settings) {
+  auto model = std::make_unique<TetElementModel>(std::move(mesh), settings.material);
+  return AddDeformableBody(std::make_unique<DeformableBody>(std::move(model), settings));
+}
+
+DeformableBody* DeformableWorld::AddDeformableBody(std::unique_ptr<DeformableBody> body) {
+  TAUT_DEMAND(body != nullptr, "AddDeformableBody: body is null");
+  bodies_.push_back(std::make_unique<DeformableCollisionObject>(std::move(body)));
+  addCollisionObject(&bodies_.back()->collision_object(), btBroadphaseProxy::DefaultFilter,
+                     btBroadphaseProxy::AllFilter);
+  return &bodies_.back()->body();
+}
+
+void DeformableWorld::RemoveDeformableBody(DeformableBody* body) {
+  auto it = std::find_if(bodies_.begin(), bodies_.end(),
+                         [body](const auto& entry) { return &entry->body() == body; });
+  TAUT_DEMAND(it != bodies_.end(), "RemoveDeformableBody: body is not in this world");
+  removeCollisionObject(&(*it)->collision_object());
+  bodies_.erase(it);
+}
+
+void DeformableWorld::internalSingleStepSimulation(btScalar h) {
+  if (bodies_.empty()) {
+    btDiscreteDynamicsWorld::internalSingleStepSimulation(h);
+    return;
+  }
+  const auto start = std::chrono::steady_clock::now();
+  stats_ = StepStats();
+  StepDeformableBodies(static_cast<double>(h));
+  const auto rigid_start = std::chrono::steady_clock::now();
+  btDiscreteDynamicsWorld::internalSingleStepSimulation(h);  // also refreshes every AABB
+  stats_.ms_rigid = MsSince(rigid_start);
+  stats_.ms_total = MsSince(start);
+}
+
+void DeformableWorld::StepDeformableBodies(double h) {
+  const Vec3 gravity = ToEigen(getGravity());
+  auto t = std::chrono::steady_clock::now();
+  for (auto& entry : bodies_) entry->body().BeginStep(h, gravity);
+  stats_.ms_unconstrained = MsSince(t);
+  t = std::chrono::steady_clock::now();
+  for (auto& entry : bodies_) entry->body().EndStep(h);
+  stats_.ms_integrate = MsSince(t);
+}
+
+}  // namespace taut

@@ -1,0 +1,28 @@
+// Per-substep statistics of the deformable step, readable by the user and written by the demos.
+#pragma once
+
+namespace taut {
+
+// What one world substep did and how long each stage took (DESIGN.md "One step", stage 8).
+struct StepStats {
+  // Time per stage [ms].
+  double ms_unconstrained = 0.0;  // assemble forces and A, factor, solve v*
+  double ms_rows = 0.0;           // evaluate constraint rows and Jacobians
+  double ms_solve = 0.0;          // Delassus assembly, PGS, SQP updates
+  double ms_integrate = 0.0;      // x = x0 + h v
+  double ms_rigid = 0.0;          // Bullet's own rigid step
+  double ms_total = 0.0;
+  // Constraint work.
+  int rows_strain = 0;            // active strain-limit rows (last SQP iteration)
+  int rows_energy = 0;            // active energy-limit rows
+  int rows_contact = 0;           // contact normal + friction rows
+  int pgs_sweeps = 0;             // total over SQP iterations
+  int sqp_iterations = 0;
+  double violation_before = 0.0;  // max(0, -C) at the unconstrained prediction x*
+  double violation_after = 0.0;   // max(0, -C) at the end of the step
+  bool converged = true;          // SQP reached its tolerance (false: stopped at the cap)
+
+  int rows_total() const { return rows_strain + rows_energy + rows_contact; }
+};
+
+}  // namespace taut

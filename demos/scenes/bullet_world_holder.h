@@ -1,0 +1,27 @@
+// The Bullet objects every scene needs, owned together, with a taut DeformableWorld on top.
+#pragma once
+
+#include <btBulletDynamicsCommon.h>
+
+#include <memory>
+
+#include "bullet_bridge/deformable_world.h"
+
+namespace taut {
+
+// Collision configuration, dispatcher, broadphase, rigid solver and the world, in build order.
+struct BulletWorldHolder {
+  BulletWorldHolder();
+  ~BulletWorldHolder();
+  btDefaultCollisionConfiguration configuration;
+  btCollisionDispatcher dispatcher{&configuration};
+  btDbvtBroadphase broadphase;
+  btSequentialImpulseConstraintSolver solver;
+  DeformableWorld world{&dispatcher, &broadphase, &solver, &configuration};
+  // Rigid bodies and shapes added by the scene, deleted with the holder.
+  std::vector<std::unique_ptr<btCollisionShape>> shapes;
+  std::vector<std::unique_ptr<btRigidBody>> rigid_bodies;
+  std::vector<std::unique_ptr<btDefaultMotionState>> motion_states;
+};
+
+}  // namespace taut

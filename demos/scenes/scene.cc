@@ -1,0 +1,70 @@
+#include "demos/scenes/scene.h"
+
+#include <cstring>
+
+#include "plugin/tet_element_model.h"
+#include "plugin/vtk_writer.h"
+
+namespace taut {
+
+void Scene::Step(double dt) { world().stepSimulation(dt, 1, dt); }
+
+void Scene::WriteVtkFrame(const std::string& dir, int frame) const {
+  for (int b = 0; b < world().num_deformable_bodies(); ++b) {
+    const DeformableBody& body = world().deformable_body(b);
+    const auto* tets = dynamic_cast<const TetElementModel*>(&body.model());
+    if (tets == nullptr) continue;
+    std::vector<Vec3> positions(body.num_nodes());
+    for (int i = 0; i < body.num_nodes(); ++i) positions[i] = body.node_position(i);
+    char name[64];
+    std::snprintf(name, sizeof(name), "_%06d.vtk", frame);
+    WriteVtkMesh(dir + "/" + body.name() + name, tets->mesh(), &positions);
+  }
+}
+
+namespace {
+// FNV-1a over raw bytes.
+void HashBytes(uint64_t& hash, const void* data, size_t size) {
+  const auto* bytes = static_cast<const unsigned char*>(data);
+  for (size_t i = 0; i < size; ++i) {
+    hash ^= bytes[i];
+    hash *= 1099511628211ull;
+  }
+}
+}  // namespace
+
+uint64_t Scene::CalcStateHash() const {
+  uint64_t hash = 14695981039346656037ull;
+  for (int b = 0; b < world().num_deformable_bodies(); ++b) {
+    const DeformableBody& body = world().deformable_body(b);
+    HashBytes(hash, body.x().data(), sizeof(double) * body.x().size());
+    HashBytes(hash, body.v().data(), sizeof(double) * body.v().size());
+  }
+  const btCollisionObjectArray& objects = world().getCollisionObjectArray();
+  for (int i = 0; i < objects.size(); ++i) {
+    const btRigidBody* rigid = btRigidBody::upcast(objects[i]);
+    if (rigid == nullptr) continue;
+    const btTransform& t = rigid->getWorldTransform();
+    double pose[12];
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) pose[3 * r + c] = t.getBasis()[r][c];
+      pose[9 + r] = t.getOrigin()[r];
+    }
+    HashBytes(hash, pose, sizeof(pose));
+    const btVector3 lin = rigid->getLinearVelocity(), ang = rigid->getAngularVelocity();
+    const double vel[6] = {lin.x(), lin.y(), lin.z(), ang.x(), ang.y(), ang.z()};
+    HashBytes(hash, vel, sizeof(vel));
+  }
+  return hash;
+}
+
+const SceneInfo& FindScene(const std::string& name) {
+  std::string known;
+  for (const SceneInfo& info : SceneRegistry()) {
+    if (info.name == name) return info;
+    known += (known.empty() ? "" : ", ") + info.name;
+  }
+  throw InputError("unknown scene '" + name + "'; known scenes: " + known);
+}
+
+}  // namespace taut

@@ -1,0 +1,59 @@
+// A headless demo scene: built from options, stepped, and summarized (DESIGN.md "Demo output").
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "demos/scenes/bullet_world_holder.h"
+
+namespace taut {
+
+// One scene of the demo binary, benchmarks and tests.
+class Scene {
+ public:
+  virtual ~Scene() = default;
+  // Advances the scene by one step of length dt (one Bullet substep).
+  virtual void Step(double dt);
+  // Names of the scene-specific per-step CSV columns.
+  virtual std::vector<std::string> CsvColumns() const { return {}; }
+  // Values for CsvColumns() after the current step.
+  virtual void AppendCsvValues(std::vector<double>& /*values*/) const {}
+  // Scene figures for summary.json (e.g. tip_displacement_m per material).
+  virtual void WriteFigures(nlohmann::json& figures) const = 0;
+  // Writes VTK files of every deformable body for frame `frame` into dir.
+  virtual void WriteVtkFrame(const std::string& dir, int frame) const;
+
+  DeformableWorld& world() { return holder_.world; }
+  const DeformableWorld& world() const { return holder_.world; }
+  // FNV-1a hash of every deformable x, v and every rigid transform and velocity (bitwise).
+  uint64_t CalcStateHash() const;
+
+ protected:
+  BulletWorldHolder holder_;
+};
+
+// Command-line options of a scene run.
+struct SceneOptions {
+  int steps = 0;    // 0: the scene's default
+  double dt = 0.0;  // 0: the scene's default [s]
+};
+
+// A registered scene: name, one-line description, defaults and factory.
+struct SceneInfo {
+  std::string name;
+  std::string description;
+  int default_steps;
+  double default_dt;
+  std::function<std::unique_ptr<Scene>()> make;
+};
+
+// Every scene, in the order `taut-demo --list` prints them.
+const std::vector<SceneInfo>& SceneRegistry();
+// Finds a scene by name; throws InputError listing the known names when missing.
+const SceneInfo& FindScene(const std::string& name);
+
+}  // namespace taut

@@ -1,0 +1,33 @@
+// Paper A's cantilever (Fig. 2): 1 m x 0.2 m x 0.2 m tet beams, fixed at x = 0, under gravity.
+#pragma once
+
+#include "demos/scenes/scene.h"
+
+namespace taut {
+
+// One beam per material, side by side along y. Figures: tip displacement per material.
+class TetBeamScene : public Scene {
+ public:
+  // A beam material of the scene.
+  struct Beam {
+    std::string name;
+    DeformableBodySettings settings;
+  };
+  // Beams 1 x 0.2 x 0.2 m cut into cells_x x 2 x 2 cubes (6 tets each; 10 -> 240 tets).
+  explicit TetBeamScene(const std::vector<Beam>& beams, int cells_x = 10, int cells_yz = 2);
+  // The materials: E = 200 kPa and E = 5 kPa, density 1000 kg/m^3, nu = 0.3.
+  static std::vector<Beam> DefaultBeams();
+
+  void Step(double dt) override;
+  std::vector<std::string> CsvColumns() const override;
+  void AppendCsvValues(std::vector<double>& values) const override;
+  void WriteFigures(nlohmann::json& figures) const override;
+  // Displacement of the tip centre (mean of the x = L nodes) of beam b [m].
+  Vec3 CalcTipDisplacement(int b) const;
+
+ private:
+  std::vector<std::vector<int>> tip_nodes_;  // (num_beams) nodes at x = L
+  std::vector<double> max_tip_;              // largest |tip displacement| seen [m]
+};
+
+}  // namespace taut

@@ -1,0 +1,125 @@
+// taut-demo: runs one headless scene and writes DIR/summary.json, DIR/steps.csv and, with --vtk,
+// VTK frames for ParaView (DESIGN.md "Demo output").
+#include <CLI/CLI.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include "demos/scenes/scene.h"
+
+namespace {
+
+// Median of a copy of the values.
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+// Runs the scene and writes its outputs; returns the process exit code.
+int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::string& out_dir,
+             bool vtk, int vtk_every) {
+  namespace fs = std::filesystem;
+  fs::create_directories(out_dir);
+  std::unique_ptr<taut::Scene> scene = info.make();
+  std::ofstream csv(out_dir + "/steps.csv");
+  csv.precision(17);
+  csv << "step,time_s,ms_step,ms_unconstrained,ms_rows,ms_solve,ms_rigid,rows_strain,"
+         "rows_energy,rows_contact,pgs_sweeps,sqp_iterations,violation_before,violation_after";
+  for (const std::string& column : scene->CsvColumns()) csv << "," << column;
+  csv << "\n";
+  std::vector<double> ms_steps, values;
+  int max_sqp = 0, total_sweeps = 0;
+  double max_violation = 0.0;
+  const auto run_start = std::chrono::steady_clock::now();
+  auto last_progress = run_start;
+  if (vtk) scene->WriteVtkFrame(out_dir, 0);
+  for (int step = 1; step <= steps; ++step) {
+    const auto t0 = std::chrono::steady_clock::now();
+    scene->Step(dt);
+    const auto t1 = std::chrono::steady_clock::now();
+    const double ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
+    ms_steps.push_back(ms);
+    const taut::StepStats& s = scene->world().last_step_stats();
+    max_sqp = std::max(max_sqp, s.sqp_iterations);
+    total_sweeps += s.pgs_sweeps;
+    max_violation = std::max(max_violation, s.violation_after);
+    csv << step << "," << step * dt << "," << ms << "," << s.ms_unconstrained << "," << s.ms_rows
+        << "," << s.ms_solve << "," << s.ms_rigid << "," << s.rows_strain << "," << s.rows_energy
+        << "," << s.rows_contact << "," << s.pgs_sweeps << "," << s.sqp_iterations << ","
+        << s.violation_before << "," << s.violation_after;
+    values.clear();
+    scene->AppendCsvValues(values);
+    for (double v : values) csv << "," << v;
+    csv << "\n";
+    if (vtk && step % vtk_every == 0) scene->WriteVtkFrame(out_dir, step / vtk_every);
+    if (std::chrono::duration<double>(t1 - last_progress).count() > 1.0 || step == steps) {
+      std::fprintf(stderr, "\r%s: step %d/%d (%.0f%%), %.3f ms/step", info.name.c_str(), step,
+                   steps, 100.0 * step / steps, Median(ms_steps));
+      last_progress = t1;
+    }
+  }
+  std::fprintf(stderr, "\n");
+  nlohmann::json summary;
+  summary["scene"] = info.name;
+  summary["description"] = info.description;
+  summary["steps"] = steps;
+  summary["dt"] = dt;
+  summary["ms_per_step_median"] = Median(ms_steps);
+  summary["wall_time_s"] =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
+  summary["max_violation"] = max_violation;
+  summary["max_sqp_iterations"] = max_sqp;
+  summary["pgs_sweeps_total"] = total_sweeps;
+  char hash[32];
+  std::snprintf(hash, sizeof(hash), "%016llx",
+                static_cast<unsigned long long>(scene->CalcStateHash()));
+  summary["state_hash"] = hash;
+  nlohmann::json figures;
+  scene->WriteFigures(figures);
+  summary["figures"] = figures;
+  std::ofstream(out_dir + "/summary.json") << summary.dump(2) << "\n";
+  std::cout << summary.dump(2) << "\n";
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"taut-demo: headless scenes of limited-elasticity deformable bodies in Bullet"};
+  bool list = false, vtk = false;
+  std::string scene_name, out_dir;
+  int steps = 0, vtk_every = 1;
+  double dt = 0.0;
+  app.add_flag("--list", list, "List the scenes, one per line, and exit");
+  app.add_option("scene", scene_name, "Scene to run (see --list)");
+  app.add_option("--steps", steps, "Number of steps (default: the scene's)")->check(CLI::NonNegativeNumber);
+  app.add_option("--dt", dt, "Time step in seconds (default: the scene's)")->check(CLI::NonNegativeNumber);
+  app.add_option("--out", out_dir, "Output folder (default: out/<scene>)");
+  app.add_flag("--vtk", vtk, "Write VTK frames of every deformable body");
+  app.add_option("--vtk-every", vtk_every, "Write a VTK frame every N steps")->check(CLI::PositiveNumber);
+  CLI11_PARSE(app, argc, argv);
+  try {
+    if (list) {
+      for (const taut::SceneInfo& info : taut::SceneRegistry())
+        std::cout << info.name << "  # " << info.description << "\n";
+      return 0;
+    }
+    if (scene_name.empty()) {
+      std::cerr << "taut-demo: name a scene (see --list)\n";
+      return 2;
+    }
+    const taut::SceneInfo& info = taut::FindScene(scene_name);
+    if (steps == 0) steps = info.default_steps;
+    if (dt == 0.0) dt = info.default_dt;
+    if (out_dir.empty()) out_dir = "out/" + info.name;
+    return RunScene(info, steps, dt, out_dir, vtk, vtk_every);
+  } catch (const std::exception& e) {
+    std::cerr << "taut-demo: " << e.what() << "\n";
+    return 1;
+  }
+}

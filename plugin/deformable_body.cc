@@ -1,0 +1,149 @@
+#include "plugin/deformable_body.h"
+
+#include <cmath>
+
+namespace taut {
+
+DeformableBody::DeformableBody(std::unique_ptr<ElementModel> model,
+                               const DeformableBodySettings& settings)
+    : model_(std::move(model)), settings_(settings) {
+  TAUT_DEMAND(model_ != nullptr, "body '", settings.name, "': element model is null");
+  settings_.Validate();
+  const int n = model_->num_nodes();
+  x_ = model_->rest_positions();
+  v_.setZero(3 * n);
+  x0_ = x_;
+  v0_ = v_;
+  v_star_ = v_;
+  force_.setZero(3 * n);
+  external_.setZero(3 * n);
+  kinematic_v_.setZero(3 * n);
+  scratch_.setZero(3 * n);
+  model_->CalcLumpedMass(settings_.material.density, mass_);
+  kinds_.assign(n, NodeKind::kFree);
+  kinematic_targets_.assign(n, Vec3::Zero());
+  for (int i = 0; i < n; ++i)
+    TAUT_DEMAND(mass_[i] > 0.0, "body '", name(), "': node ", i,
+                " belongs to no element (zero mass); remove unused nodes from the mesh");
+}
+
+void DeformableBody::set_x(const VecX& x) {
+  TAUT_DEMAND(x.size() == x_.size(), "body '", name(), "': set_x expects ", x_.size(),
+              " values, got ", x.size());
+  TAUT_DEMAND(x.allFinite(), "body '", name(), "': set_x got a non-finite position");
+  x_ = x;
+}
+
+void DeformableBody::set_v(const VecX& v) {
+  TAUT_DEMAND(v.size() == v_.size(), "body '", name(), "': set_v expects ", v_.size(),
+              " values, got ", v.size());
+  TAUT_DEMAND(v.allFinite(), "body '", name(), "': set_v got a non-finite velocity");
+  v_ = v;
+}
+
+void DeformableBody::CheckNode(int node, const char* what) const {
+  TAUT_DEMAND(node >= 0 && node < num_nodes(), "body '", name(), "': ", what, " node ", node,
+              " out of range [0, ", num_nodes(), ")");
+}
+
+void DeformableBody::FixNodes(const std::vector<int>& nodes) {
+  for (int i : nodes) {
+    CheckNode(i, "FixNodes:");
+    kinds_[i] = NodeKind::kFixed;
+  }
+  kinds_changed_ = true;
+}
+
+int DeformableBody::FixNodesWhere(const std::function<bool(const Vec3&)>& pred) {
+  std::vector<int> nodes;
+  for (int i = 0; i < num_nodes(); ++i)
+    if (pred(model_->rest_positions().segment<3>(3 * i))) nodes.push_back(i);
+  FixNodes(nodes);
+  return static_cast<int>(nodes.size());
+}
+
+void DeformableBody::SetKinematicTarget(int node, const Vec3& target) {
+  CheckNode(node, "SetKinematicTarget:");
+  TAUT_DEMAND(target.allFinite(), "body '", name(), "': kinematic target of node ", node,
+              " is not finite");
+  if (kinds_[node] != NodeKind::kKinematic) kinds_changed_ = true;
+  kinds_[node] = NodeKind::kKinematic;
+  kinematic_targets_[node] = target;
+}
+
+void DeformableBody::ReleaseNode(int node) {
+  CheckNode(node, "ReleaseNode:");
+  if (kinds_[node] != NodeKind::kFree) kinds_changed_ = true;
+  kinds_[node] = NodeKind::kFree;
+}
+
+void DeformableBody::AddNodeForce(int node, const Vec3& force) {
+  CheckNode(node, "AddNodeForce:");
+  TAUT_DEMAND(force.allFinite(), "body '", name(), "': force on node ", node, " is not finite");
+  external_.segment<3>(3 * node) += force;
+}
+
+void DeformableBody::BeginStep(double h, const Vec3& gravity) {
+  if (kinds_changed_) {
+    system_.Build(*model_, kinds_);
+    kinds_changed_ = false;
+  }
+  x0_ = x_;
+  v0_ = v_;
+  // Forces at x0: elastic (updates rotations) + gravity + external.
+  force_ = external_;
+  model_->UpdateRotationsAndAddForces(x0_, force_);
+  for (int i = 0; i < num_nodes(); ++i) force_.segment<3>(3 * i) += mass_[i] * gravity;
+  // Prescribed velocities: fixed nodes 0, kinematic nodes reach their target at the step end.
+  kinematic_v_.setZero();
+  for (int i = 0; i < num_nodes(); ++i)
+    if (kinds_[i] == NodeKind::kKinematic)
+      kinematic_v_.segment<3>(3 * i) = (kinematic_targets_[i] - x0_.segment<3>(3 * i)) / h;
+  // A = (1 + h alpha) M + (h beta + h^2) K;  b = M v0 + h f(x0) - (h beta + h^2) K v_kin.
+  const double c_M = 1.0 + h * settings_.mass_damping;
+  const double c_K = h * settings_.stiffness_damping + h * h;
+  system_.Assemble(*model_, mass_, c_M, c_K);
+  system_.Factor(name());
+  for (int i = 0; i < num_nodes(); ++i)
+    v_star_.segment<3>(3 * i) = mass_[i] * v0_.segment<3>(3 * i) + h * force_.segment<3>(3 * i);
+  scratch_.setZero();
+  model_->AddScaledStiffnessTimes(c_K, kinematic_v_, scratch_);
+  v_star_ -= scratch_;
+  system_.Solve(v_star_);
+  v_star_ += kinematic_v_;
+  v_ = v_star_;
+  external_.setZero();
+}
+
+void DeformableBody::SolveSystem(Eigen::Ref<VecX> rhs) const { system_.Solve(rhs); }
+
+void DeformableBody::SolveSystemColumns(Eigen::Ref<MatX> rhs) const { system_.SolveColumns(rhs); }
+
+void DeformableBody::EndStep(double h) {
+  if (!v_.allFinite()) {
+    int node = 0;
+    while (node < num_nodes() && v_.segment<3>(3 * node).allFinite()) ++node;
+    x_ = x0_;
+    v_ = v0_;
+    throw SimulationError(internal::Concat("body '", name(), "': non-finite velocity at node ",
+                                           node, " (stage: integrate); state kept at step start"));
+  }
+  x_ = x0_ + h * v_;
+}
+
+double DeformableBody::CalcKineticEnergy() const {
+  double energy = 0.0;
+  for (int i = 0; i < num_nodes(); ++i) energy += 0.5 * mass_[i] * v_.segment<3>(3 * i).squaredNorm();
+  return energy;
+}
+
+void DeformableBody::CalcBounds(Vec3& lo, Vec3& hi) const {
+  lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+  hi = -lo;
+  for (int i = 0; i < num_nodes(); ++i) {
+    lo = lo.cwiseMin(x_.segment<3>(3 * i));
+    hi = hi.cwiseMax(x_.segment<3>(3 * i));
+  }
+}
+
+}  // namespace taut

@@ -1,0 +1,88 @@
+// A deformable FEM body: runtime state and the linearized backward-Euler step (MATH.md §5).
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "plugin/deformable_body_settings.h"
+#include "plugin/element_model.h"
+#include "plugin/implicit_system.h"
+#include "plugin/node_kind.h"
+
+namespace taut {
+
+// Runtime deformable body. Positions x and velocities v are 3N vectors (node-major xyz).
+// One step h, split into stages so constraint solvers can act between them:
+//   BeginStep:  A = M + h D + h^2 K,  b = M v0 + h f(x0)  (forces linearized at the step start,
+//               D = alpha M + beta K), factor A, v* = A^-1 b, set v = v*;
+//   (constraints change v by A^-1 J^T lambda, using SolveSystem);
+//   EndStep:    x = x0 + h v.
+class DeformableBody {
+ public:
+  DeformableBody(std::unique_ptr<ElementModel> model, const DeformableBodySettings& settings);
+
+  const std::string& name() const { return settings_.name; }
+  const DeformableBodySettings& settings() const { return settings_; }
+  const ElementModel& model() const { return *model_; }
+  ElementModel& mutable_model() { return *model_; }
+  int num_nodes() const { return model_->num_nodes(); }
+  const VecX& x() const { return x_; }
+  const VecX& v() const { return v_; }
+  const VecX& x0() const { return x0_; }          // positions at the step start
+  const VecX& v_star() const { return v_star_; }  // unconstrained velocity of this step
+  const VecX& mass() const { return mass_; }      // lumped mass per node [kg]
+  NodeKind node_kind(int i) const { return kinds_[i]; }
+  Vec3 node_position(int i) const { return x_.segment<3>(3 * i); }
+  const ImplicitSystem& system() const { return system_; }
+
+  // Sets positions/velocities (3N); throws InputError on size mismatch or non-finite values.
+  void set_x(const VecX& x);
+  void set_v(const VecX& v);
+  // Velocity during a step (between BeginStep and EndStep), e.g. v* + A^-1 J^T lambda.
+  VecX& mutable_v() { return v_; }
+
+  // Fixes the listed nodes (v = 0). Throws InputError for an index out of range.
+  void FixNodes(const std::vector<int>& nodes);
+  // Fixes every node whose rest position satisfies pred; returns how many.
+  int FixNodesWhere(const std::function<bool(const Vec3&)>& pred);
+  // Makes the node kinematic and drives it to `target` by the end of each step.
+  void SetKinematicTarget(int node, const Vec3& target);
+  // Frees a fixed or kinematic node.
+  void ReleaseNode(int node);
+  // Adds an external force on a node for the next step only [N].
+  void AddNodeForce(int node, const Vec3& force);
+
+  // Stage 2 of the world step: assemble, factor and solve the unconstrained velocity v*.
+  void BeginStep(double h, const Vec3& gravity);
+  // rhs <- A^-1 rhs on free DOFs, zero on fixed/kinematic DOFs (rhs is 3N).
+  void SolveSystem(Eigen::Ref<VecX> rhs) const;
+  // Same for every column of a 3N x k matrix.
+  void SolveSystemColumns(Eigen::Ref<MatX> rhs) const;
+  // Stage 7: x = x0 + h v. Throws SimulationError (keeping the step-start state) on NaN/Inf.
+  void EndStep(double h);
+
+  // Elastic energy at the current x [J].
+  double CalcElasticEnergy() const { return model_->CalcEnergy(x_); }
+  // Kinetic energy 1/2 v^T M v [J].
+  double CalcKineticEnergy() const;
+  // Axis-aligned bounds of the current positions.
+  void CalcBounds(Vec3& lo, Vec3& hi) const;
+
+ private:
+  void CheckNode(int node, const char* what) const;
+
+  std::unique_ptr<ElementModel> model_;
+  DeformableBodySettings settings_;
+  VecX x_, v_, x0_, v0_, v_star_, mass_;
+  VecX force_;          // elastic + external + gravity at x0 (3N)
+  VecX external_;       // user forces for the next step (3N)
+  VecX kinematic_v_;    // prescribed velocities of kinematic nodes (3N, zero elsewhere)
+  VecX scratch_;        // 3N
+  std::vector<NodeKind> kinds_;
+  std::vector<Vec3> kinematic_targets_;
+  ImplicitSystem system_;
+  bool kinds_changed_ = true;
+};
+
+}  // namespace taut

@@ -1,0 +1,18 @@
+#include "plugin/deformable_body_settings.h"
+
+#include <cmath>
+
+#include "plugin/common.h"
+
+namespace taut {
+
+void DeformableBodySettings::Validate() const {
+  material.Validate("body '" + name + "'");
+  TAUT_DEMAND(std::isfinite(mass_damping) && mass_damping >= 0.0, "body '", name,
+              "': mass damping (Rayleigh alpha) must be finite and >= 0 1/s, got ", mass_damping);
+  TAUT_DEMAND(std::isfinite(stiffness_damping) && stiffness_damping >= 0.0, "body '", name,
+              "': stiffness damping (Rayleigh beta) must be finite and >= 0 s, got ",
+              stiffness_damping);
+}
+
+}  // namespace taut

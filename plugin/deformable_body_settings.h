@@ -1,0 +1,20 @@
+// Settings a deformable body is made from (validated when the body is made).
+#pragma once
+
+#include <string>
+
+#include "plugin/material.h"
+
+namespace taut {
+
+// Material, damping and identity of one deformable body.
+struct DeformableBodySettings {
+  std::string name = "body";  // used in error messages and reports
+  Material material;          // E, nu, rho (validated: E > 0, nu in (-1, 0.5), rho > 0)
+  double mass_damping = 0.0;       // Rayleigh alpha [1/s], >= 0: damping force -alpha M v
+  double stiffness_damping = 0.0;  // Rayleigh beta [s], >= 0: damping force -beta K v
+  // Throws InputError naming the body and the quantity when out of range.
+  void Validate() const;
+};
+
+}  // namespace taut

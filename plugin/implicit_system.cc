@@ -1,0 +1,102 @@
+#include "plugin/implicit_system.h"
+
+#include <algorithm>
+
+
+namespace taut {
+
+void ImplicitSystem::Build(const ElementModel& model, const std::vector<NodeKind>& kinds) {
+  const int num_dofs = 3 * model.num_nodes();
+  dof_to_free_.assign(num_dofs, -1);
+  free_to_dof_.clear();
+  for (int i = 0; i < model.num_nodes(); ++i)
+    if (kinds[i] == NodeKind::kFree)
+      for (int k = 0; k < 3; ++k) {
+        dof_to_free_[3 * i + k] = static_cast<int>(free_to_dof_.size());
+        free_to_dof_.push_back(3 * i + k);
+      }
+  const int n = num_free_dofs();
+  // Pattern: every element couples all DOFs of its free nodes, plus the diagonal.
+  const int k = model.nodes_per_element();
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(static_cast<size_t>(model.num_elements()) * k * k * 9 + n);
+  for (int i = 0; i < n; ++i) triplets.emplace_back(i, i, 0.0);
+  for (int e = 0; e < model.num_elements(); ++e) {
+    const int* nodes = model.element_nodes(e);
+    for (int a = 0; a < k; ++a)
+      for (int b = 0; b < k; ++b)
+        for (int c = 0; c < 3; ++c)
+          for (int r = 0; r < 3; ++r) {
+            const int row = dof_to_free_[3 * nodes[a] + r];
+            const int col = dof_to_free_[3 * nodes[b] + c];
+            if (row >= 0 && col >= 0) triplets.emplace_back(row, col, 0.0);
+          }
+  }
+  A_.resize(n, n);
+  A_.setFromTriplets(triplets.begin(), triplets.end());
+  A_.makeCompressed();
+  // Value index of (row, col) by binary search in the column.
+  auto index_of = [this](int row, int col) {
+    const int* begin = A_.innerIndexPtr() + A_.outerIndexPtr()[col];
+    const int* end = A_.innerIndexPtr() + A_.outerIndexPtr()[col + 1];
+    const int* it = std::lower_bound(begin, end, row);
+    TAUT_ASSERT(it != end && *it == row);
+    return static_cast<int>(it - A_.innerIndexPtr());
+  };
+  diagonal_.resize(n);
+  for (int i = 0; i < n; ++i) diagonal_[i] = index_of(i, i);
+  element_map_.assign(static_cast<size_t>(model.num_elements()) * k * k * 9, -1);
+  int* map = element_map_.data();
+  for (int e = 0; e < model.num_elements(); ++e) {
+    const int* nodes = model.element_nodes(e);
+    for (int a = 0; a < k; ++a)
+      for (int b = 0; b < k; ++b, map += 9)
+        for (int c = 0; c < 3; ++c)
+          for (int r = 0; r < 3; ++r) {
+            const int row = dof_to_free_[3 * nodes[a] + r];
+            const int col = dof_to_free_[3 * nodes[b] + c];
+            map[3 * c + r] = (row >= 0 && col >= 0) ? index_of(row, col) : -1;
+          }
+  }
+  if (n > 0) ldlt_.Analyze(A_);
+  rhs_free_.resize(n);
+}
+
+void ImplicitSystem::Assemble(const ElementModel& model, const VecX& mass, double c_M,
+                              double c_K) {
+  double* values = A_.valuePtr();
+  std::fill(values, values + A_.nonZeros(), 0.0);
+  for (int i = 0; i < num_free_dofs(); ++i) values[diagonal_[i]] += c_M * mass[free_to_dof_[i] / 3];
+  model.AddScaledStiffness(c_K, element_map_, values);
+}
+
+void ImplicitSystem::Factor(const std::string& body) {
+  if (num_free_dofs() == 0) return;
+  if (!ldlt_.Factorize(A_) || ldlt_.num_negative_pivots() > 0)
+    throw SimulationError(internal::Concat("body '", body,
+                                           "': system matrix A = M + hD + h^2 K is not positive "
+                                           "definite (stage: factorization)"));
+}
+
+void ImplicitSystem::Solve(Eigen::Ref<VecX> rhs) const {
+  const int n = num_free_dofs();
+  for (int i = 0; i < n; ++i) rhs_free_[i] = rhs[free_to_dof_[i]];
+  rhs.setZero();
+  if (n == 0) return;
+  ldlt_.Solve(rhs_free_);
+  for (int i = 0; i < n; ++i) rhs[free_to_dof_[i]] = rhs_free_[i];
+}
+
+void ImplicitSystem::SolveColumns(Eigen::Ref<MatX> rhs) const {
+  const int n = num_free_dofs();
+  if (columns_free_.rows() != n || columns_free_.cols() < rhs.cols())
+    columns_free_.resize(n, std::max<Eigen::Index>(rhs.cols(), columns_free_.cols()));
+  auto cols = columns_free_.leftCols(rhs.cols());
+  for (int i = 0; i < n; ++i) cols.row(i) = rhs.row(free_to_dof_[i]);
+  rhs.setZero();
+  if (n == 0) return;
+  ldlt_.SolveColumns(cols);
+  for (int i = 0; i < n; ++i) rhs.row(free_to_dof_[i]) = cols.row(i);
+}
+
+}  // namespace taut

@@ -1,0 +1,46 @@
+// The sparse system A = c_M M + c_K K of one body on its free DOFs, with a fixed pattern.
+#pragma once
+
+#include <Eigen/SparseCore>
+#include <vector>
+
+#include "plugin/element_model.h"
+#include "plugin/node_kind.h"
+#include "plugin/sparse_ldlt.h"
+
+namespace taut {
+
+// Symbolic structure built once per body (and again only when nodes are fixed or released):
+// the free-DOF numbering, the full symmetric CSC pattern of A, the element -> value index map
+// and the LDL^T analysis. Each step then writes values through the map (no setFromTriplets,
+// no allocation) and refactors numerically.
+class ImplicitSystem {
+ public:
+  // Builds the pattern for the model's connectivity with the given node kinds.
+  void Build(const ElementModel& model, const std::vector<NodeKind>& kinds);
+  // A = c_M diag(mass) + c_K K(rotations of the model's last update), on free DOFs.
+  void Assemble(const ElementModel& model, const VecX& mass, double c_M, double c_K);
+  // Numeric factorization; throws SimulationError naming `body` if A is not positive definite.
+  void Factor(const std::string& body);
+  // rhs (3N) <- A^-1 rhs on free DOFs; constrained DOFs set to 0.
+  void Solve(Eigen::Ref<VecX> rhs) const;
+  // Same for each column of rhs (3N x k).
+  void SolveColumns(Eigen::Ref<MatX> rhs) const;
+
+  int num_free_dofs() const { return static_cast<int>(free_to_dof_.size()); }
+  // Free index of a DOF (3 node + axis), or -1 when fixed or kinematic.
+  int free_index(int dof) const { return dof_to_free_[dof]; }
+  const Eigen::SparseMatrix<double>& matrix() const { return A_; }
+
+ private:
+  std::vector<int> dof_to_free_;   // (3N) free index or -1
+  std::vector<int> free_to_dof_;   // (num_free)
+  std::vector<int> diagonal_;      // (num_free) value index of A(i,i)
+  std::vector<int> element_map_;   // (num_elements x k^2 x 9) value index or -1
+  Eigen::SparseMatrix<double> A_;  // full symmetric, free DOFs
+  SparseLdlt ldlt_;
+  mutable VecX rhs_free_;
+  mutable MatX columns_free_;
+};
+
+}  // namespace taut

@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# Shared helpers for the set-up scripts: `source scripts/build.sh` from another script, or run it
+# directly to install dependencies and build one configuration:
+#   scripts/build.sh [release|asan]     (default release; build dirs build/release, build/asan)
+# Honours TAUT_JOBS (parallel build jobs, default 2).
+
+# Repository root, from this file's own path.
+TAUT_ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+TAUT_JOBS="${TAUT_JOBS:-2}"
+
+# Prints a stage banner.
+taut_stage() {
+  echo "==> $*"
+}
+
+# Installs the Debian packages (no-op when all are present).
+taut_install_deps() {
+  bash "${TAUT_ROOT}/scripts/install_deps.sh"
+}
+
+# Configures DIR with Ninja and the given cmake arguments, then builds it. DIR is reused; a DIR
+# configured with another generator is removed first, since cmake refuses to switch generators.
+taut_configure_build() {
+  local dir="$1"
+  shift
+  local cache="${dir}/CMakeCache.txt"
+  if [[ -f "${cache}" ]] && ! grep -qx 'CMAKE_GENERATOR:INTERNAL=Ninja' "${cache}"; then
+    taut_stage "${dir} was configured with another generator; removing it"
+    rm -rf "${dir}"
+  fi
+  taut_stage "Configuring ${dir} ($*)"
+  cmake -G Ninja -S "${TAUT_ROOT}" -B "${dir}" "$@"
+  taut_stage "Building ${dir} (-j${TAUT_JOBS})"
+  cmake --build "${dir}" -j"${TAUT_JOBS}"
+}
+
+# Release build in build/release (tests, demos and benchmarks on).
+taut_build_release() {
+  taut_configure_build build/release -DCMAKE_BUILD_TYPE=Release
+}
+
+# Debug build with AddressSanitizer and UBSan in build/asan (no benchmarks, no demos).
+taut_build_asan() {
+  taut_configure_build build/asan -DCMAKE_BUILD_TYPE=Debug -DTAUT_SANITIZE=ON \
+    -DTAUT_BUILD_BENCH=OFF -DTAUT_BUILD_DEMOS=OFF
+}
+
+if [[ "${BASH_SOURCE[0]}" == "$0" ]]; then
+  set -euo pipefail
+  cd "${TAUT_ROOT}"
+  config="${1:-release}"
+  case "${config}" in
+    release | asan) ;;
+    *)
+      echo "usage: $0 [release|asan]" >&2
+      exit 2
+      ;;
+  esac
+  taut_stage "Installing dependencies"
+  taut_install_deps
+  "taut_build_${config}"
+fi

@@ -1,0 +1,116 @@
+#!/usr/bin/env bash
+# Builds and runs every check: (1) Release build + ctest, (2) install into build/stage and build
+# and run tests/consumer against the installed package, (3) Debug ASan/UBSan build + ctest.
+#   scripts/run_tests.sh [--quick | --sanitize-only]
+#     --quick          stages 1-2 only (skip the sanitizer build)
+#     --sanitize-only  stage 3 only
+# Ends with one line giving each stage's wall time; exits non-zero on any failure.
+set -euo pipefail
+# shellcheck source-path=SCRIPTDIR source=build.sh
+source "$(dirname "${BASH_SOURCE[0]}")/build.sh"
+cd "${TAUT_ROOT}"
+
+run_release=1
+run_consumer=1
+run_asan=1
+for arg in "$@"; do
+  case "${arg}" in
+    --quick) run_asan=0 ;;
+    --sanitize-only)
+      run_release=0
+      run_consumer=0
+      ;;
+    -h | --help)
+      sed -n '2,7p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
+      exit 0
+      ;;
+    *)
+      echo "error: unknown option '${arg}' (use --quick or --sanitize-only)" >&2
+      exit 2
+      ;;
+  esac
+done
+if ((run_asan == 0 && run_release == 0)); then
+  echo "error: --quick and --sanitize-only together leave nothing to run" >&2
+  exit 2
+fi
+
+# Runs ctest on a build dir; a suite that finds no tests is a failure, not a pass.
+run_ctest() {
+  taut_stage "ctest --test-dir $1"
+  ctest --test-dir "$1" --output-on-failure --no-tests=error -j"${TAUT_JOBS}"
+}
+
+# Stage 1: Release build and its tests.
+stage_release() {
+  taut_build_release
+  run_ctest build/release
+}
+
+# Stage 2: install the Release build and build a standalone project against it.
+stage_consumer() {
+  if [[ ! -f build/release/build.ninja ]]; then
+    taut_build_release
+  fi
+  local stage_dir="${TAUT_ROOT}/build/stage"
+  taut_stage "Installing build/release into build/stage (fresh prefix)"
+  rm -rf "${stage_dir}"
+  cmake --install build/release --prefix "${stage_dir}"
+  taut_stage "Configuring tests/consumer against build/stage"
+  cmake -G Ninja -S tests/consumer -B build/consumer -DCMAKE_BUILD_TYPE=Release \
+    -DCMAKE_PREFIX_PATH="${stage_dir}"
+  taut_stage "Building tests/consumer"
+  cmake --build build/consumer -j"${TAUT_JOBS}"
+  taut_stage "Running the consumer"
+  build/consumer/taut_consumer
+}
+
+# Stage 3: Debug build with AddressSanitizer + UBSan and its tests.
+stage_asan() {
+  taut_build_asan
+  UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}" run_ctest build/asan
+}
+
+timings=()
+current=""
+current_start=0
+
+# Prints the per-stage wall times; names the stage that failed, if any.
+print_timings() {
+  local rc=$?
+  if [[ -n "${current}" ]]; then
+    timings+=("${current} $((SECONDS - current_start))s FAILED")
+  fi
+  local line="" t
+  for t in "${timings[@]}"; do
+    line+="${line:+, }${t}"
+  done
+  echo "==> Stage times: ${line:-none}"
+  if ((rc != 0)); then
+    echo "==> run_tests.sh FAILED (exit ${rc})" >&2
+  fi
+}
+trap print_timings EXIT
+
+# Runs one stage function and records its wall time.
+run_stage() {
+  local name="$1"
+  current="${name}"
+  current_start=${SECONDS}
+  taut_stage "Stage ${name}"
+  "stage_${name}"
+  timings+=("${name} $((SECONDS - current_start))s")
+  current=""
+}
+
+current="deps"
+current_start=${SECONDS}
+taut_stage "Installing dependencies"
+taut_install_deps
+timings+=("deps $((SECONDS - current_start))s")
+current=""
+
+if ((run_release)); then run_stage release; fi
+if ((run_consumer)); then run_stage consumer; fi
+if ((run_asan)); then run_stage asan; fi
+taut_stage "All stages passed"

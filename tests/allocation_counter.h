@@ -1,0 +1,23 @@
+// Counts heap allocations made by the current thread, to prove that hot paths allocate nothing.
+// The global operator new/delete replacements live once in allocation_counter.cc for the whole
+// test binary; test files must not define their own.
+#pragma once
+
+#include <cstddef>
+
+namespace taut::testing {
+
+// Number of operator new calls made by this thread since the program started.
+std::size_t AllocationCount();
+
+// Counts the allocations made while it is alive: `ScopedAllocationCounter c; ...; c.count()`.
+class ScopedAllocationCounter {
+ public:
+  ScopedAllocationCounter() : start_(AllocationCount()) {}
+  std::size_t count() const { return AllocationCount() - start_; }
+
+ private:
+  std::size_t start_;
+};
+
+}  // namespace taut::testing
