@@ -50,11 +50,36 @@ DeformableBody* DeformableWorld::AddTetBody(std::shared_ptr<const TetMesh> mesh,
 
 DeformableBody* DeformableWorld::AddDeformableBody(std::unique_ptr<DeformableBody> body) {
   TAUT_DEMAND(body != nullptr, "AddDeformableBody: body is null");
-  bodies_.push_back(std::make_unique<DeformableCollisionObject>(std::move(body)));
+  auto entry = std::make_unique<Entry>();
+  entry->object = std::make_unique<DeformableCollisionObject>(std::move(body));
+  bodies_.push_back(std::move(entry));
   addCollisionObject(&bodies_.back()->collision_object(), btBroadphaseProxy::DefaultFilter,
                      btBroadphaseProxy::AllFilter);
   return &bodies_.back()->body();
 }
+
+DeformableWorld::Entry& DeformableWorld::FindEntry(const DeformableBody* body) {
+  for (auto& entry : bodies_)
+    if (&entry->body() == body) return *entry;
+  throw InputError("deformable body is not in this world");
+}
+
+StrainLimitConstraint* DeformableWorld::SetStrainLimits(DeformableBody* body,
+                                                        const StrainLimitSettings& limits) {
+  Entry& entry = FindEntry(body);
+  auto source = std::make_unique<StrainLimitConstraint>(*body, limits, next_source_id_++);
+  StrainLimitConstraint* result = source.get();
+  auto& sources = entry.sources;
+  sources.erase(std::remove_if(sources.begin(), sources.end(),
+                               [](const auto& s) {
+                                 return dynamic_cast<StrainLimitConstraint*>(s.get()) != nullptr;
+                               }),
+                sources.end());
+  sources.push_back(std::move(source));
+  return result;
+}
+
+void DeformableWorld::ClearLimits(DeformableBody* body) { FindEntry(body).sources.clear(); }
 
 void DeformableWorld::RemoveDeformableBody(DeformableBody* body) {
   auto it = std::find_if(bodies_.begin(), bodies_.end(),
@@ -83,6 +108,26 @@ void DeformableWorld::StepDeformableBodies(double h) {
   auto t = std::chrono::steady_clock::now();
   for (auto& entry : bodies_) entry->body().BeginStep(h, gravity);
   stats_.ms_unconstrained = MsSince(t);
+  // Limits: one SQP per constrained body (limit rows couple no bodies).
+  std::vector<DeformableBody*> island(1);
+  std::vector<ConstraintSource*> sources;
+  for (auto& entry : bodies_) {
+    if (entry->sources.empty()) continue;
+    island[0] = &entry->body();
+    sources.clear();
+    for (auto& source : entry->sources) sources.push_back(source.get());
+    StepStats body_stats;
+    entry->solver.Solve(h, island, sources, solver_settings_, body_stats);
+    stats_.ms_rows += body_stats.ms_rows;
+    stats_.ms_solve += body_stats.ms_solve;
+    stats_.rows_strain += body_stats.rows_strain;
+    stats_.rows_energy += body_stats.rows_energy;
+    stats_.pgs_sweeps += body_stats.pgs_sweeps;
+    stats_.sqp_iterations = std::max(stats_.sqp_iterations, body_stats.sqp_iterations);
+    stats_.violation_before = std::max(stats_.violation_before, body_stats.violation_before);
+    stats_.violation_after = std::max(stats_.violation_after, body_stats.violation_after);
+    stats_.converged = stats_.converged && body_stats.converged;
+  }
   t = std::chrono::steady_clock::now();
   for (auto& entry : bodies_) entry->body().EndStep(h);
   stats_.ms_integrate = MsSince(t);

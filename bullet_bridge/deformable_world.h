@@ -8,7 +8,9 @@
 #include <vector>
 
 #include "bullet_bridge/deformable_collision_object.h"
+#include "constraints/sqp_solver.h"
 #include "constraints/step_stats.h"
+#include "constraints/strain_limit_constraint.h"
 #include "plugin/tet_mesh.h"
 
 namespace taut {
@@ -33,6 +35,15 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   // Removes and destroys the body.
   void RemoveDeformableBody(DeformableBody* body);
 
+  // Limits the principal stretches of every tet of `body` (paper A). Replaces earlier strain
+  // limits of that body. Throws InputError for invalid settings or a body that is not a tet body.
+  StrainLimitConstraint* SetStrainLimits(DeformableBody* body, const StrainLimitSettings& limits);
+  // Removes every constraint source (limits) of the body.
+  void ClearLimits(DeformableBody* body);
+  // Solver settings used by every constrained body.
+  SqpSettings& mutable_solver_settings() { return solver_settings_; }
+  const SqpSettings& solver_settings() const { return solver_settings_; }
+
   int num_deformable_bodies() const { return static_cast<int>(bodies_.size()); }
   DeformableBody& deformable_body(int i) { return bodies_[i]->body(); }
   const DeformableBody& deformable_body(int i) const { return bodies_[i]->body(); }
@@ -47,7 +58,20 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   // Unconstrained implicit step of every deformable body, then integration.
   void StepDeformableBodies(double h);
 
-  std::vector<std::unique_ptr<DeformableCollisionObject>> bodies_;
+  // A body with its Bullet proxy, its constraint sources and its solver (warm starts).
+  struct Entry {
+    std::unique_ptr<DeformableCollisionObject> object;
+    std::vector<std::unique_ptr<ConstraintSource>> sources;
+    SqpSolver solver;
+    DeformableBody& body() { return object->body(); }
+    btCollisionObject& collision_object() { return object->collision_object(); }
+  };
+  // The entry of a body; throws InputError when the body is not in this world.
+  Entry& FindEntry(const DeformableBody* body);
+
+  std::vector<std::unique_ptr<Entry>> bodies_;
+  SqpSettings solver_settings_;
+  int next_source_id_ = 0;
   btEmptyAlgorithm::CreateFunc empty_algorithm_;
   StepStats stats_;
 };

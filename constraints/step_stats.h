@@ -20,6 +20,7 @@ struct StepStats {
   int sqp_iterations = 0;
   double violation_before = 0.0;  // max(0, -C) at the unconstrained prediction x*
   double violation_after = 0.0;   // max(0, -C) at the end of the step
+  double stationarity = 0.0;      // ||A(v - v*) - J^T lambda|| / ||J^T lambda|| at the end
   bool converged = true;          // SQP reached its tolerance (false: stopped at the cap)
 
   int rows_total() const { return rows_strain + rows_energy + rows_contact; }

@@ -59,6 +59,8 @@ class DeformableBody {
   void SolveSystem(Eigen::Ref<VecX> rhs) const;
   // Same for every column of a 3N x k matrix.
   void SolveSystemColumns(Eigen::Ref<MatX> rhs) const;
+  // out = A v with this step's system matrix (free DOFs; 0 on fixed/kinematic DOFs).
+  void ApplySystemMatrix(const VecX& v, VecX& out) const { system_.Multiply(v, out); }
   // Stage 7: x = x0 + h v. Throws SimulationError (keeping the step-start state) on NaN/Inf.
   void EndStep(double h);
 

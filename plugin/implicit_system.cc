@@ -60,6 +60,7 @@ void ImplicitSystem::Build(const ElementModel& model, const std::vector<NodeKind
   }
   if (n > 0) ldlt_.Analyze(A_);
   rhs_free_.resize(n);
+  product_free_.resize(n);
 }
 
 void ImplicitSystem::Assemble(const ElementModel& model, const VecX& mass, double c_M,
@@ -97,6 +98,14 @@ void ImplicitSystem::SolveColumns(Eigen::Ref<MatX> rhs) const {
   if (n == 0) return;
   ldlt_.SolveColumns(cols);
   for (int i = 0; i < n; ++i) rhs.row(free_to_dof_[i]) = cols.row(i);
+}
+
+void ImplicitSystem::Multiply(const VecX& v, VecX& out) const {
+  const int n = num_free_dofs();
+  for (int i = 0; i < n; ++i) rhs_free_[i] = v[free_to_dof_[i]];
+  product_free_.noalias() = A_ * rhs_free_;
+  out.setZero(v.size());
+  for (int i = 0; i < n; ++i) out[free_to_dof_[i]] = product_free_[i];
 }
 
 }  // namespace taut

@@ -27,6 +27,9 @@ class ImplicitSystem {
   // Same for each column of rhs (3N x k).
   void SolveColumns(Eigen::Ref<MatX> rhs) const;
 
+  // out (3N) = A v on free DOFs (v read on free DOFs only), 0 on constrained DOFs.
+  void Multiply(const VecX& v, VecX& out) const;
+
   int num_free_dofs() const { return static_cast<int>(free_to_dof_.size()); }
   // Free index of a DOF (3 node + axis), or -1 when fixed or kinematic.
   int free_index(int dof) const { return dof_to_free_[dof]; }
@@ -41,6 +44,7 @@ class ImplicitSystem {
   SparseLdlt ldlt_;
   mutable VecX rhs_free_;
   mutable MatX columns_free_;
+  mutable VecX product_free_;
 };
 
 }  // namespace taut

@@ -1,5 +1,6 @@
 #include "plugin/signed_svd.h"
 
+#include <Eigen/LU>
 #include <Eigen/SVD>
 
 namespace taut {

@@ -10,16 +10,20 @@ constexpr double kWidth = 0.2;
 }  // namespace
 
 std::vector<TetBeamScene::Beam> TetBeamScene::DefaultBeams() {
-  std::vector<Beam> beams;
-  for (double E : {200e3, 5e3}) {
+  auto make = [](const std::string& name, double E, std::optional<StrainLimitSettings> limits) {
     Beam beam;
-    beam.name = E > 1e4 ? "stiff_200kPa" : "soft_5kPa";
-    beam.settings.name = beam.name;
+    beam.name = name;
+    beam.settings.name = name;
     beam.settings.material = {E, 0.3, 1000.0};
     beam.settings.mass_damping = 1.0;
-    beams.push_back(beam);
-  }
-  return beams;
+    beam.limits = limits;
+    return beam;
+  };
+  const double free = kUnlimitedStretch;
+  return {make("stiff_200kPa", 200e3, std::nullopt), make("soft_5kPa", 5e3, std::nullopt),
+          make("soft_5kPa_anisotropic", 5e3,
+               StrainLimitSettings::PerAxis(Vec3(0.0, 0.96, 0.96), Vec3(free, 1.04, 1.04))),
+          make("soft_5kPa_isotropic", 5e3, StrainLimitSettings::Isotropic(0.96, 1.04))};
 }
 
 TetBeamScene::TetBeamScene(const std::vector<Beam>& beams, int cells_x, int cells_yz) {
@@ -31,10 +35,12 @@ TetBeamScene::TetBeamScene(const std::vector<Beam>& beams, int cells_x, int cell
     mesh->source = beams[b].name;
     DeformableBody* body = world().AddTetBody(mesh, beams[b].settings);
     body->FixNodesWhere([](const Vec3& X) { return X.x() < 1e-9; });
+    if (beams[b].limits) world().SetStrainLimits(body, *beams[b].limits);
     std::vector<int> tip;
     for (int i = 0; i < body->num_nodes(); ++i)
       if (mesh->nodes[i].x() > kLength - 1e-9) tip.push_back(i);
     tip_nodes_.push_back(tip);
+    limited_.push_back(beams[b].limits.has_value());
   }
   max_tip_.assign(beams.size(), 0.0);
 }
@@ -45,6 +51,17 @@ Vec3 TetBeamScene::CalcTipDisplacement(int b) const {
   for (int i : tip_nodes_[b])
     sum += body.node_position(i) - body.model().rest_positions().segment<3>(3 * i);
   return sum / static_cast<double>(tip_nodes_[b].size());
+}
+
+double TetBeamScene::CalcLength(int b) const {
+  // Distance from the clamped face centre to the tip centre (stretch of the beam axis).
+  const DeformableBody& body = world().deformable_body(b);
+  Vec3 tip = Vec3::Zero(), root = Vec3::Zero();
+  for (int i : tip_nodes_[b]) tip += body.node_position(i);
+  tip /= static_cast<double>(tip_nodes_[b].size());
+  for (int i = 0; i < body.num_nodes(); ++i)
+    if (body.node_kind(i) == NodeKind::kFixed) root += body.node_position(i);
+  return (tip - root / static_cast<double>(tip_nodes_[b].size())).norm();
 }
 
 void TetBeamScene::Step(double dt) {
@@ -75,6 +92,8 @@ void TetBeamScene::WriteFigures(nlohmann::json& figures) const {
     entry["tip_displacement_z_m"] = tip.z();
     entry["max_tip_displacement_m"] = max_tip_[b];
     entry["num_tets"] = body.model().num_elements();
+    entry["strain_limited"] = b < static_cast<int>(limited_.size()) && limited_[b];
+    entry["length_m"] = CalcLength(b);
   }
 }
 

@@ -1,6 +1,8 @@
 // Paper A's cantilever (Fig. 2): 1 m x 0.2 m x 0.2 m tet beams, fixed at x = 0, under gravity.
 #pragma once
 
+#include <optional>
+
 #include "demos/scenes/scene.h"
 
 namespace taut {
@@ -12,10 +14,13 @@ class TetBeamScene : public Scene {
   struct Beam {
     std::string name;
     DeformableBodySettings settings;
+    std::optional<StrainLimitSettings> limits;  // none: unlimited
   };
   // Beams 1 x 0.2 x 0.2 m cut into cells_x x 2 x 2 cubes (6 tets each; 10 -> 240 tets).
   explicit TetBeamScene(const std::vector<Beam>& beams, int cells_x = 10, int cells_yz = 2);
-  // The materials: E = 200 kPa and E = 5 kPa, density 1000 kg/m^3, nu = 0.3.
+  // Paper A Fig. 2: stiff E = 200 kPa; compliant E = 5 kPa unlimited; compliant anisotropic
+  // (free along the beam axis x, 0.96..1.04 on y and z); compliant isotropic (0.96..1.04 on all).
+  // Density 1000 kg/m^3, nu = 0.3.
   static std::vector<Beam> DefaultBeams();
 
   void Step(double dt) override;
@@ -24,9 +29,12 @@ class TetBeamScene : public Scene {
   void WriteFigures(nlohmann::json& figures) const override;
   // Displacement of the tip centre (mean of the x = L nodes) of beam b [m].
   Vec3 CalcTipDisplacement(int b) const;
+  // Current distance between the centres of the clamped face and the tip face of beam b [m].
+  double CalcLength(int b) const;
 
  private:
   std::vector<std::vector<int>> tip_nodes_;  // (num_beams) nodes at x = L
+  std::vector<bool> limited_;                // (num_beams) has strain limits
   std::vector<double> max_tip_;              // largest |tip displacement| seen [m]
 };
 

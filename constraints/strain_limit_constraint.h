@@ -1,0 +1,39 @@
+// Strain limits of one tet body as a source of SQP rows (paper A; MATH.md §2-§3).
+#pragma once
+
+#include "constraints/constraint_row.h"
+#include "constraints/strain_limit_rows.h"
+#include "plugin/tet_element_model.h"
+
+namespace taut {
+
+// Emits the strain-limit rows of every tet of a body whose C is below the activation margin.
+class StrainLimitConstraint final : public ConstraintSource {
+ public:
+  // `body` must be a tet body; settings are validated (throws InputError naming the body).
+  // `source_id` (< 2^16) makes row keys unique among the sources of a world.
+  StrainLimitConstraint(const DeformableBody& body, const StrainLimitSettings& settings,
+                        int source_id);
+
+  const DeformableBody& body() const override { return body_; }
+  int AppendRows(const VecX& x, int body_index, std::vector<ConstraintRow>& rows) override;
+  double CalcMaxViolation(const VecX& x) const override;
+  double CalcViolationSum(const VecX& x) const override;
+
+  const StrainLimitSettings& settings() const { return settings_; }
+  // Strain |G q_j| - 1 along limit axis j of every element at x (for reports), largest value.
+  double CalcMaxAxisStrain(const VecX& x, int axis) const;
+
+ private:
+  // Largest violation of element e at x.
+  double CalcElementViolation(const VecX& x, int e) const;
+
+  const DeformableBody& body_;
+  const TetElementModel& tets_;
+  StrainLimitSettings settings_;
+  StrainLimitParams params_;
+  std::uint64_t key_prefix_;
+  std::vector<StrainLimitRow> element_rows_;  // scratch, reused
+};
+
+}  // namespace taut

@@ -1,0 +1,96 @@
+// User-facing strain-limit settings of a tet body (paper A §3; MATH.md §2-§3) and their
+// compiled, validated form used by the row evaluation (constraints/strain_limit_rows.h).
+//
+// Limits are given per material limit axis j = 0, 1, 2 as stretch ratios: s_min[j] <= s <= s_max[j]
+// for the principal stretches s of the deformation gradient, projected onto axis j by the chosen
+// StrainProjection. The limit axes are the columns q_j of a rotation Q in rest coordinates (the
+// body frame, or one frame per element for fibre directions); with Q = I they are the world axes
+// of the rest mesh. Internally the limits become kappa^j = 1/|s^j - 1| (kappa = 0: unlimited,
+// MATH.md §3), so no infinity reaches a formula.
+#pragma once
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "plugin/common.h"
+
+namespace taut {
+
+// How axis limits become limits along the principal directions v_i (V' = Q^T V, w = V' e_i).
+enum class StrainProjection {
+  kHyperbolic,           // paper A eqs. 7-8: s^{j,i} = 1 + d^j / |V'_ji|; 18 rows per tet.
+  kOrthogonal,           // paper A eqs. 19-20: s^{j,i} = 1 + d^j |V'_ji|; freezes (MATH.md §6 A1).
+  kLinearInterpolation,  // paper A eqs. 21-22: s^i = ||diag(s^j) w||; 6 rows; needs caps.
+  kEllipsoid,            // MATH.md §3 2-norm variant: d^i = 1 / ||K w||; isotropy-consistent.
+};
+
+// Value of s_max[j] meaning "no stretch limit on this axis" (s_min[j] = 0 means no compress limit).
+constexpr double kUnlimitedStretch = std::numeric_limits<double>::infinity();
+// Default activation margin tau: rows with C < tau are emitted (C = 1 at rest, 0 at the limit).
+constexpr double kDefaultStrainActivationMargin = 0.2;
+
+// Strain limits of one body. Build with Isotropic() or PerAxis(), then Validate().
+struct StrainLimitSettings {
+  // Compress limit per material axis j [-]: in (0, 1), or 0 = unlimited. Default: unlimited.
+  Vec3 s_min = Vec3::Zero();
+  // Stretch limit per material axis j [-]: in (1, +inf), or kUnlimitedStretch. Default: unlimited.
+  Vec3 s_max = Vec3::Constant(kUnlimitedStretch);
+  // Projection of axis limits onto principal directions. Default: paper A's hyperbolic rule.
+  StrainProjection projection = StrainProjection::kHyperbolic;
+  // Body limit frame Q: columns are the limit axes in rest coordinates; a rotation. Default I.
+  Mat3 frame = Mat3::Identity();
+  // Optional per-element frames (fibre directions), one rotation per tet; when non-empty they
+  // replace `frame`. Default: empty.
+  std::vector<Mat3> element_frames;
+  // kOrthogonal / kLinearInterpolation only: s used for an unlimited compress axis, in [0, 1).
+  // Default 0 (d = -1, MATH.md §3). Results of these modes depend on the caps.
+  double unlimited_s_min_cap = 0.0;
+  // kOrthogonal / kLinearInterpolation only: s used for an unlimited stretch axis, finite, > 1.
+  // Default 2 (d = 1, MATH.md §3).
+  double unlimited_s_max_cap = 2.0;
+  // Activation margin tau >= 0 (may be +inf): emit rows with C < tau. C is the remaining fraction
+  // of the limit (1 at rest, 0 at the limit), so tau = 0.2 emits rows past 80 % of their limit.
+  double activation_margin = kDefaultStrainActivationMargin;
+  // Gap clamp epsilon of MATH.md §2 R1 [s^2 units], >= 0, finite. Default 1e-2.
+  double svd_gap_epsilon = 1e-2;
+  // Use the frozen-frame Jacobian (dV/dx = 0), for comparison with the exact one. Default false.
+  bool freeze_frame_jacobian = false;
+
+  // Equal limits s_min <= s <= s_max on all three axes (0 / kUnlimitedStretch = unlimited).
+  static StrainLimitSettings Isotropic(double s_min, double s_max,
+                                       StrainProjection projection = StrainProjection::kHyperbolic);
+  // Per-axis limits (paper A §3.2: s^j_min, s^j_max on material axis j).
+  static StrainLimitSettings PerAxis(const Vec3& s_min, const Vec3& s_max,
+                                     StrainProjection projection = StrainProjection::kHyperbolic);
+
+  // Throws InputError naming `where`, the quantity, the axis or element and the valid range when a
+  // limit is NaN or out of range, s_min > s_max, a frame is not a rotation, the number of element
+  // frames differs from num_elements, or a cap / margin / epsilon is out of range.
+  void Validate(int num_elements, const std::string& where) const;
+};
+
+// Compiled limits of one body, as used by the row evaluation (MATH.md §3).
+struct StrainLimitParams {
+  StrainProjection projection = StrainProjection::kHyperbolic;
+  Vec3 kappa_min = Vec3::Zero();     // kappa^j = 1/(1 - s_min[j]); 0 = unlimited
+  Vec3 kappa_max = Vec3::Zero();     // kappa^j = 1/(s_max[j] - 1); 0 = unlimited
+  Vec3 d_min_capped = Vec3::Zero();  // s_min[j] - 1, caps on unlimited axes (OP, LI), in [-1, 0)
+  Vec3 d_max_capped = Vec3::Zero();  // s_max[j] - 1, caps on unlimited axes (OP, LI), > 0
+  bool has_min = false;  // some axis has a compress limit (else no C_min rows in any mode)
+  bool has_max = false;  // some axis has a stretch limit (else no C_max rows in any mode)
+  double activation_margin = kDefaultStrainActivationMargin;  // tau
+  double svd_gap_epsilon = 1e-2;                              // R1 epsilon
+  bool freeze_frame_jacobian = false;                         // dV/dx := 0
+};
+
+// Converts validated settings into kappa and capped deviations (MATH.md §3).
+StrainLimitParams CalcStrainLimitParams(const StrainLimitSettings& settings);
+
+// The limit frame Q of element e: element_frames[e] when given, else the body frame.
+const Mat3& SelectStrainLimitFrame(const StrainLimitSettings& settings, int element);
+
+// Name of a projection mode for messages and file output ("hyperbolic", ...).
+const char* GetStrainProjectionName(StrainProjection projection);
+
+}  // namespace taut

@@ -1,0 +1,231 @@
+#include "plugin/sparse_ldlt.h"
+
+#include <Eigen/OrderingMethods>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+namespace taut {
+
+// Symbolic phase: validate, order (AMD), permute the pattern, etree and column counts, buffers.
+void SparseLdlt::Analyze(const SparseMatrix& pattern) {
+  analyzed_ = false;
+  factorized_ = false;
+  failed_column_ = -1;
+  num_negative_pivots_ = 0;
+  TAUT_DEMAND(pattern.rows() == pattern.cols(), "SparseLdlt::Analyze: matrix must be square, got ",
+              pattern.rows(), "x", pattern.cols());
+  TAUT_DEMAND(pattern.rows() > 0, "SparseLdlt::Analyze: matrix is empty");
+  TAUT_DEMAND(pattern.isCompressed(),
+              "SparseLdlt::Analyze: matrix must be compressed (call makeCompressed())");
+  n_ = static_cast<int>(pattern.rows());
+  const int nnz_a = static_cast<int>(pattern.nonZeros());
+  a_outer_.assign(pattern.outerIndexPtr(), pattern.outerIndexPtr() + n_ + 1);
+  a_inner_.assign(pattern.innerIndexPtr(), pattern.innerIndexPtr() + nnz_a);
+
+  // AMD on the symmetric pattern triu(A) + triu(A)^T. Eigen returns the inverse permutation:
+  // indices()(k) is the old index of the k-th pivot (SimplicialCholesky uses it the same way).
+  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> new_to_old;
+  Eigen::AMDOrdering<int> amd;
+  amd(pattern.selfadjointView<Eigen::Upper>(), new_to_old);
+  perm_.assign(new_to_old.indices().data(), new_to_old.indices().data() + n_);
+  iperm_.assign(n_, -1);
+  for (int k = 0; k < n_; ++k) iperm_[perm_[k]] = k;
+
+  BuildPermutedUpper(pattern);
+  CalcEliminationTree();
+
+  // Every buffer the numeric phase and the solves touch, sized once here.
+  const int nnz_l = col_start_[n_];
+  l_row_.assign(nnz_l, 0);
+  l_val_.assign(nnz_l, 0.0);
+  d_.assign(n_, 0.0);
+  d_inv_.assign(n_, 0.0);
+  y_.assign(n_, 0.0);
+  flag_.assign(n_, -1);
+  stack_.assign(n_, 0);
+  col_fill_.assign(n_, 0);
+  work_.assign(static_cast<size_t>(n_) * kMaxBlockColumns, 0.0);
+  analyzed_ = true;
+}
+
+// Counts, then fills, the entries of C per column, remembering where each value sits in A.
+void SparseLdlt::BuildPermutedUpper(const SparseMatrix& pattern) {
+  // An upper entry A(r, c), r <= c, lands at (min(i, j), max(i, j)) of C with i = P(r), j = P(c).
+  const int* outer = pattern.outerIndexPtr();
+  const int* inner = pattern.innerIndexPtr();
+  c_start_.assign(n_ + 1, 0);
+  for (int c = 0; c < n_; ++c)
+    for (int p = outer[c]; p < outer[c + 1]; ++p) {
+      const int r = inner[p];
+      if (r > c) continue;
+      c_start_[std::max(iperm_[r], iperm_[c]) + 1]++;
+    }
+  for (int j = 0; j < n_; ++j) c_start_[j + 1] += c_start_[j];
+  const int nnz_c = c_start_[n_];
+  c_row_.assign(nnz_c, 0);
+  c_source_.assign(nnz_c, 0);
+  std::vector<int> next(c_start_.begin(), c_start_.end() - 1);
+  for (int c = 0; c < n_; ++c)
+    for (int p = outer[c]; p < outer[c + 1]; ++p) {
+      const int r = inner[p];
+      if (r > c) continue;
+      const int i = iperm_[r], j = iperm_[c];
+      const int q = next[std::max(i, j)]++;
+      c_row_[q] = std::min(i, j);
+      c_source_[q] = p;
+    }
+}
+
+// Davis' LDL symbolic pass over the columns of C.
+void SparseLdlt::CalcEliminationTree() {
+  // Row k of L has a nonzero in column i exactly for the nodes on the etree paths from each
+  // i' < k with C(i', k) != 0 up to k (Davis 2005, sec. 2). Walk them, mark with flag = k, and
+  // count one entry in every column passed; the first walk that reaches a root makes k its parent.
+  parent_.assign(n_, -1);
+  std::vector<int> flag(n_, -1);
+  std::vector<int64_t> count(n_, 0);
+  for (int k = 0; k < n_; ++k) {
+    flag[k] = k;
+    for (int q = c_start_[k]; q < c_start_[k + 1]; ++q) {
+      for (int i = c_row_[q]; flag[i] != k; i = parent_[i]) {
+        if (parent_[i] == -1) parent_[i] = k;
+        count[i]++;
+        flag[i] = k;
+      }
+    }
+  }
+  col_start_.assign(n_ + 1, 0);
+  int64_t total = 0;
+  for (int j = 0; j < n_; ++j) {
+    total += count[j];
+    TAUT_DEMAND(total <= std::numeric_limits<int>::max(),
+                "SparseLdlt::Analyze: L would have more than 2^31 nonzeros (n = ", n_, ")");
+    col_start_[j + 1] = static_cast<int>(total);
+  }
+}
+
+// Up-looking numeric phase: row k of L and d_k from column k of C, for k = 0..n-1.
+bool SparseLdlt::Factorize(const SparseMatrix& A) {
+  TAUT_DEMAND(analyzed_, "SparseLdlt::Factorize called before Analyze");
+  TAUT_DEMAND(A.rows() == n_ && A.cols() == n_ && A.isCompressed() &&
+                  A.nonZeros() == static_cast<Eigen::Index>(a_inner_.size()) &&
+                  std::equal(a_outer_.begin(), a_outer_.end(), A.outerIndexPtr()),
+              "SparseLdlt::Factorize: matrix (", A.rows(), "x", A.cols(), ", ", A.nonZeros(),
+              " nonzeros) does not have the analysed pattern (", n_, "x", n_, ", ", a_inner_.size(),
+              " nonzeros)");
+  TAUT_ASSERT(std::equal(a_inner_.begin(), a_inner_.end(), A.innerIndexPtr()));
+  factorized_ = false;
+  failed_column_ = -1;
+  num_negative_pivots_ = 0;
+  const double* a_val = A.valuePtr();
+  std::fill(flag_.begin(), flag_.end(), -1);
+  std::fill(col_fill_.begin(), col_fill_.end(), 0);
+
+  for (int k = 0; k < n_; ++k) {
+    // Scatter column k of C into y and push the pattern of row k of L onto the stack, in
+    // topological order (descendants before ancestors) at stack_[top..n).
+    int top = n_;
+    flag_[k] = k;
+    for (int q = c_start_[k]; q < c_start_[k + 1]; ++q) {
+      int i = c_row_[q];
+      y_[i] += a_val[c_source_[q]];
+      int len = 0;
+      for (; flag_[i] != k; i = parent_[i]) {
+        stack_[len++] = i;
+        flag_[i] = k;
+      }
+      while (len > 0) stack_[--top] = stack_[--len];
+    }
+    // Sparse triangular solve L(0:k,0:k) z = y with l_kj = z_j / d_j, and
+    // d_k = a_kk - sum_j l_kj^2 d_j = a_kk - sum_j l_kj z_j.
+    double d = y_[k];
+    y_[k] = 0.0;
+    for (; top < n_; ++top) {
+      const int j = stack_[top];
+      const double z_j = y_[j];
+      y_[j] = 0.0;
+      const int end = col_start_[j] + col_fill_[j];
+      for (int p = col_start_[j]; p < end; ++p) y_[l_row_[p]] -= l_val_[p] * z_j;
+      const double l_kj = z_j * d_inv_[j];
+      d -= l_kj * z_j;
+      l_row_[end] = k;
+      l_val_[end] = l_kj;
+      col_fill_[j]++;
+    }
+    if (d == 0.0 || !std::isfinite(d)) {
+      failed_column_ = perm_[k];
+      return false;
+    }
+    if (d < 0.0) num_negative_pivots_++;
+    d_[k] = d;
+    d_inv_[k] = 1.0 / d;
+  }
+  factorized_ = true;
+  return true;
+}
+
+// Checks that a factor exists and the right-hand side fits it.
+void SparseLdlt::DemandReadyToSolve(Eigen::Index size) const {
+  TAUT_DEMAND(factorized_, "SparseLdlt: solve without a successful Factorize");
+  TAUT_DEMAND(size == n_, "SparseLdlt: right-hand side has ", size, " rows, the matrix has ", n_);
+}
+
+// One right-hand side through the width-1 kernel.
+void SparseLdlt::Solve(Eigen::Ref<VecX> b) const {
+  DemandReadyToSolve(b.size());
+  SolveBlock<1>(b.data(), b.size());
+}
+
+// Blocks of 16 columns, then one of 8 and one of 4, then single columns.
+void SparseLdlt::SolveColumns(Eigen::Ref<MatX> B) const {
+  DemandReadyToSolve(B.rows());
+  const Eigen::Index stride = B.outerStride();
+  Eigen::Index c = 0;
+  const Eigen::Index m = B.cols();
+  for (; c + kMaxBlockColumns <= m; c += kMaxBlockColumns)
+    SolveBlock<kMaxBlockColumns>(B.data() + c * stride, stride);
+  if (c + 8 <= m) {
+    SolveBlock<8>(B.data() + c * stride, stride);
+    c += 8;
+  }
+  if (c + 4 <= m) {
+    SolveBlock<4>(B.data() + c * stride, stride);
+    c += 4;
+  }
+  for (; c < m; ++c) SolveBlock<1>(B.data() + c * stride, stride);
+}
+
+// x = P^T L^-T D^-1 L^-1 P b for kWidth columns at once, through the row-major workspace.
+template <int kWidth>
+void SparseLdlt::SolveBlock(double* b, Eigen::Index outer_stride) const {
+  static_assert(kWidth <= kMaxBlockColumns, "workspace holds kMaxBlockColumns columns");
+  using Row = Eigen::Matrix<double, kWidth, 1>;
+  double* w = work_.data();
+  // Row k of the (n x kWidth) row-major block X.
+  auto row = [w](int k) { return Eigen::Map<Row>(w + static_cast<size_t>(k) * kWidth); };
+  // gather: X = P B.
+  for (int k = 0; k < n_; ++k)
+    for (int c = 0; c < kWidth; ++c) w[k * kWidth + c] = b[perm_[k] + c * outer_stride];
+  // forward: L Z = X, column by column of L; zero rows (sparse right-hand sides such as columns
+  // of J^T) are skipped.
+  for (int j = 0; j < n_; ++j) {
+    const Row x_j = row(j);
+    if ((x_j.array() == 0.0).all()) continue;
+    for (int p = col_start_[j]; p < col_start_[j + 1]; ++p) row(l_row_[p]) -= l_val_[p] * x_j;
+  }
+  // diagonal: Y = D^-1 Z.
+  for (int j = 0; j < n_; ++j) row(j) *= d_inv_[j];
+  // backward: L^T W = Y, row j of W = y_j - sum_i L(i, j) w_i over the stored column j.
+  for (int j = n_ - 1; j >= 0; --j) {
+    Row s = row(j);
+    for (int p = col_start_[j]; p < col_start_[j + 1]; ++p) s -= l_val_[p] * row(l_row_[p]);
+    row(j) = s;
+  }
+  // scatter: B = P^T W.
+  for (int k = 0; k < n_; ++k)
+    for (int c = 0; c < kWidth; ++c) b[perm_[k] + c * outer_stride] = w[k * kWidth + c];
+}
+
+}  // namespace taut

@@ -1,0 +1,123 @@
+// Allocation-free sparse LDL^T factorization for the body's implicit-step matrix.
+#pragma once
+
+#include <Eigen/SparseCore>
+#include <vector>
+
+#include "plugin/common.h"
+
+namespace taut {
+
+// Sparse P A P^T = L D L^T of a symmetric matrix A (L unit lower triangular, D diagonal, P a
+// fill-reducing AMD permutation), for A = M + h D + h^2 K of the implicit step (DESIGN.md step 2,
+// MATH.md §5). The pattern of A is fixed per body while its values change every step, so the work
+// is split into a symbolic phase (Analyze, once per body: ordering, elimination tree, column
+// counts, every buffer) and a numeric phase (Factorize, every step) plus solves that never touch
+// the heap.
+//
+// Algorithm: Davis' up-looking "LDL" (T. A. Davis, "Algorithm 849: a concise sparse Cholesky
+// factorization package", ACM TOMS 31(4), 2005). Row k of L solves L(0:k,0:k) D l = A(0:k,k) with
+// the pattern of l given by the elimination-tree paths from the nonzeros of A(0:k,k) to k.
+//
+// Input: a square CSC (column-major, compressed) matrix. Only its upper triangle (row <= col) is
+// read, so it may hold the upper triangle or the full symmetric matrix; entries below the diagonal
+// are ignored (their symmetry is not checked).
+//
+// D may have negative entries: Factorize succeeds for any A whose leading principal minors of
+// P A P^T are nonzero and reports the number of negative pivots, which equals the number of
+// negative eigenvalues of A (Sylvester's law of inertia), so callers can detect an indefinite A.
+//
+// Not thread-safe: Solve and SolveColumns share a workspace inside the object.
+class SparseLdlt {
+ public:
+  using SparseMatrix = Eigen::SparseMatrix<double>;  // column-major, int indices
+
+  // Largest number of right-hand sides SolveColumns carries through one pass over L.
+  static constexpr int kMaxBlockColumns = 16;
+
+  // Symbolic phase: AMD ordering of the symmetric pattern, elimination tree, column counts of L,
+  // the map from A's values to the permuted upper triangle, and every workspace. Values are
+  // ignored. Throws InputError for a non-square, empty or uncompressed matrix.
+  void Analyze(const SparseMatrix& pattern);
+
+  // Numeric phase on a matrix with the analysed pattern (same outer index and nonzero count; the
+  // row indices are compared in debug builds). No heap allocation. Returns false when a pivot is
+  // zero or not finite; failed_column() then names the column of A. Throws InputError when called
+  // before Analyze or with a different size or nonzero count.
+  bool Factorize(const SparseMatrix& A);
+
+  // Solves A x = b in place (b := x). No heap allocation. Throws InputError without a successful
+  // Factorize or when b has the wrong size.
+  void Solve(Eigen::Ref<VecX> b) const;
+
+  // Solves A X = B in place for every column of B (B := X), carrying up to kMaxBlockColumns
+  // columns through each pass over L. No heap allocation. Same errors as Solve.
+  void SolveColumns(Eigen::Ref<MatX> B) const;
+
+  // Number of rows (and columns) of A.
+  int rows() const { return n_; }
+  // Nonzeros of L strictly below the diagonal (the unit diagonal is not stored).
+  int nonzeros_in_L() const { return analyzed_ ? col_start_[n_] : 0; }
+  // (n) perm[k] = column of A eliminated k-th, i.e. (P A P^T)(k, j) = A(perm[k], perm[j]).
+  const std::vector<int>& permutation() const { return perm_; }
+  // True after Analyze.
+  bool analyzed() const { return analyzed_; }
+  // True after a Factorize that returned true (and no Analyze since).
+  bool factorized() const { return factorized_; }
+  // Column of A whose pivot was zero or not finite in the last Factorize; -1 if none.
+  int failed_column() const { return failed_column_; }
+  // Number of negative entries of D in the last Factorize (up to the failed pivot on failure).
+  int num_negative_pivots() const { return num_negative_pivots_; }
+  // (n) the pivots D in elimination order (valid after a successful Factorize).
+  const std::vector<double>& pivots() const { return d_; }
+
+ private:
+  // Builds the permuted upper triangle C = triu(P A P^T) as structure plus a map into A's values.
+  void BuildPermutedUpper(const SparseMatrix& pattern);
+  // Elimination tree of C and the nonzero count of every column of L (Davis' LDL symbolic).
+  void CalcEliminationTree();
+  // Solves for kWidth columns stored at b + c * outer_stride, c = 0..kWidth-1.
+  template <int kWidth>
+  void SolveBlock(double* b, Eigen::Index outer_stride) const;
+  // Throws InputError unless a factorization is ready for right-hand sides with `size` rows.
+  void DemandReadyToSolve(Eigen::Index size) const;
+
+  int n_ = 0;
+  bool analyzed_ = false;
+  bool factorized_ = false;
+  int failed_column_ = -1;
+  int num_negative_pivots_ = 0;
+
+  // Ordering.
+  std::vector<int> perm_;   // (n) new -> old
+  std::vector<int> iperm_;  // (n) old -> new
+
+  // Pattern of A as analysed, to check the matrices handed to Factorize.
+  std::vector<int> a_outer_;  // (n + 1) column starts of A
+  std::vector<int> a_inner_;  // (nnz(A)) row indices of A
+
+  // C = triu(P A P^T) in CSC; its values are read from A through c_source_ (no copy).
+  std::vector<int> c_start_;   // (n + 1) column starts
+  std::vector<int> c_row_;     // (nnz(C)) row indices, each <= its column
+  std::vector<int> c_source_;  // (nnz(C)) index into A.valuePtr() of each entry
+
+  // Elimination tree and L in CSC (strictly lower part, rows ascending within a column).
+  std::vector<int> parent_;     // (n) etree parent, -1 at a root
+  std::vector<int> col_start_;  // (n + 1) column starts of L
+  std::vector<int> l_row_;      // (nnz(L)) row indices of L
+  std::vector<double> l_val_;   // (nnz(L)) values of L
+  std::vector<double> d_;       // (n) pivots D
+  std::vector<double> d_inv_;   // (n) 1 / D
+
+  // Factorize workspace: dense row accumulator (all zero between rows), visit flags, pattern stack
+  // and the current fill of each column of L.
+  std::vector<double> y_;      // (n)
+  std::vector<int> flag_;      // (n)
+  std::vector<int> stack_;     // (n)
+  std::vector<int> col_fill_;  // (n)
+
+  // Solve workspace: (n x kMaxBlockColumns) row-major, so one row of a block is contiguous.
+  mutable std::vector<double> work_;
+};
+
+}  // namespace taut
