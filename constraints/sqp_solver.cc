@@ -1,5 +1,7 @@
 #include "constraints/sqp_solver.h"
 
+#include "constraints/active_set_polish.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -71,18 +73,25 @@ void SqpSolver::BuildDelassus(const std::vector<DeformableBody*>& bodies) {
   W_ = 0.5 * (W_ + W_.transpose()).eval();
 }
 
+double SqpSolver::CalcViolationSum(double h, const std::vector<DeformableBody*>& bodies,
+                                   const std::vector<ConstraintSource*>& sources,
+                                   const std::vector<VecX>& v) {
+  double sum = 0.0;
+  for (ConstraintSource* source : sources) {
+    const int b = static_cast<int>(std::find(bodies.begin(), bodies.end(), &source->body()) -
+                                   bodies.begin());
+    sum += source->CalcViolationSum(bodies[b]->x0() + h * v[b]);
+  }
+  return sum;
+}
+
 double SqpSolver::CalcMerit(double h, const std::vector<DeformableBody*>& bodies,
                             const std::vector<ConstraintSource*>& sources,
                             const std::vector<VecX>& v, double rho) {
   for (size_t b = 0; b < bodies.size(); ++b) dv_[b] = v[b] - bodies[b]->v_star();
   VecX scratch;
-  double merit = 0.5 * EnergyNormSquared(bodies, dv_, scratch);
-  for (ConstraintSource* source : sources) {
-    const int b = static_cast<int>(std::find(bodies.begin(), bodies.end(), &source->body()) -
-                                   bodies.begin());
-    merit += rho * source->CalcViolationSum(bodies[b]->x0() + h * v[b]) / h;
-  }
-  return merit;
+  return 0.5 * EnergyNormSquared(bodies, dv_, scratch) +
+         rho * CalcViolationSum(h, bodies, sources, v) / h;
 }
 
 void SqpSolver::WarmStart(const std::vector<std::pair<std::uint64_t, double>>& from) {
@@ -116,6 +125,7 @@ void SqpSolver::Solve(double h, const std::vector<DeformableBody*>& bodies,
     iterate_.clear();
   }
   double rho = 0.0, last_alpha = 1.0;
+  bool restoring = false;
   VecX scratch;
   for (int k = 0;; ++k) {
     auto t_rows = std::chrono::steady_clock::now();
@@ -150,15 +160,21 @@ void SqpSolver::Solve(double h, const std::vector<DeformableBody*>& bodies,
     const double stationarity = force > 0.0 ? std::sqrt(residual / force) : std::sqrt(residual);
     stats.stationarity = stationarity;
     // Converged: feasible to tolerance and stationary, or feasible with the line search stalled
-    // (the QP direction no longer decreases the merit: more iterations would not move v).
-    if (violation <= settings.violation_tolerance &&
-        (stationarity <= settings.stationarity_tolerance || force == 0.0 ||
-         last_alpha < settings.stalled_step)) {
+    // (the QP direction no longer decreases the merit: more iterations would not move v), or
+    // feasible again after restoration.
+    const bool feasible = violation <= settings.violation_tolerance;
+    if (feasible && (restoring || stationarity <= settings.stationarity_tolerance ||
+                     force == 0.0 || last_alpha < settings.stalled_step)) {
       break;
     }
     if (k >= settings.max_iterations) {
-      stats.converged = false;
-      break;
+      // SQP cap reached while infeasible: push-only restoration steps (MATH.md §5 "incremental
+      // dlambda >= 0": feasible in a few iterations, at the price of stationarity).
+      if (feasible || k >= settings.max_iterations + settings.max_restoration_iterations) {
+        stats.converged = feasible;
+        break;
+      }
+      restoring = true;
     }
     const auto t_solve = std::chrono::steady_clock::now();
     BuildDelassus(bodies);
@@ -171,17 +187,43 @@ void SqpSolver::Solve(double h, const std::vector<DeformableBody*>& bodies,
       for (int n = 0; n < row.num_nodes; ++n)
         jdv += row.J[n].dot(bodies[row.body]->v_star().segment<3>(3 * row.nodes[n]) -
                             v_k_[row.body].segment<3>(3 * row.nodes[n]));
-      q_[c] = row.C / h + jdv;
+      q_[c] = restoring ? row.C / h : row.C / h + jdv;
     }
     pgs_rows_.assign(m, MakeUnilateralRow());
-    lambda_qp_ = lambda_;
+    if (restoring) {
+      lambda_qp_.setZero(m);
+    } else {
+      lambda_qp_ = lambda_;
+    }
     const PgsStats pgs = SolvePgs(W_, q_, pgs_rows_, lambda_qp_, settings.pgs);
     stats.pgs_sweeps += pgs.sweeps;
-    // v_QP = v* + Y lambda_QP.
+    if (settings.polish_active_set && pgs.residual > settings.polish.tolerance) {
+      stats.active_set_solves++;
+      PolishActiveSet(W_, q_, pgs_rows_, lambda_qp_, settings.pgs, settings.polish,
+                      &stats.pgs_sweeps);
+    }
+    // v_QP = v* + Y lambda_QP (restoration: v_k + Y dlambda).
     for (size_t b = 0; b < nb; ++b) {
-      v_qp_[b] = bodies[b]->v_star();
+      v_qp_[b] = restoring ? v_k_[b] : bodies[b]->v_star();
       const std::vector<int>& rows = body_rows_[b];
       for (size_t i = 0; i < rows.size(); ++i) v_qp_[b] += Y_[b].col(i) * lambda_qp_[rows[i]];
+    }
+    if (restoring) {
+      // Accept the push only as far as it lowers the total violation (halving, as the merit).
+      const double before = CalcViolationSum(h, bodies, sources, v_k_);
+      double alpha = 1.0;
+      for (int halving = 0; halving < settings.max_line_search_halvings; ++halving) {
+        for (size_t b = 0; b < nb; ++b) v_trial_[b] = v_k_[b] + alpha * (v_qp_[b] - v_k_[b]);
+        if (CalcViolationSum(h, bodies, sources, v_trial_) < before) break;
+        alpha *= 0.5;
+      }
+      for (size_t b = 0; b < nb; ++b) v_k_[b] += alpha * (v_qp_[b] - v_k_[b]);
+      lambda_ += alpha * lambda_qp_;
+      StoreMultipliers(iterate_);
+      stats.restoration_iterations++;
+      stats.sqp_iterations = k + 1;
+      stats.ms_solve += MsSince(t_solve);
+      continue;
     }
     // Merit backtracking.
     rho = std::max(rho, 2.0 * lambda_qp_.maxCoeff());

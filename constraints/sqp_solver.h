@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "constraints/constraint_row.h"
+#include "constraints/active_set_polish.h"
 #include "constraints/pgs_solver.h"
 #include "constraints/step_stats.h"
 
@@ -19,12 +20,15 @@ inline PgsSettings DefaultPgs() {
 
 // Solver settings (defaults suit interactive use; the report sweeps them).
 struct SqpSettings {
-  int max_iterations = 20;           // SQP iterations per step (cap)
+  int max_iterations = 10;           // SQP iterations per step (cap), before restoration
   double violation_tolerance = 1e-3; // stop when max(0, -C) <= this (C is a fraction of the limit)
   double stationarity_tolerance = 1e-2;  // ... and ||A(v - v*) - J^T lambda|| / ||J^T lambda||
+  int max_restoration_iterations = 10;  // push-only iterations after the cap while infeasible
   int max_line_search_halvings = 8;  // merit backtracking: alpha = 1, 1/2, ...
   double stalled_step = 0.1;         // feasible and last alpha below this: stop (stalled)
   PgsSettings pgs = DefaultPgs();     // sweeps and tolerance of each QP
+  bool polish_active_set = true;     // refine an unconverged PGS answer by active-set solves
+  ActiveSetPolishSettings polish;
   bool warm_start = true;            // warm-start lambda from the previous step by row key
 };
 
@@ -48,6 +52,10 @@ class SqpSolver {
                      const std::vector<ConstraintSource*>& sources);
   // Y_b = A_b^-1 J_b^T per body and W = J Y.
   void BuildDelassus(const std::vector<DeformableBody*>& bodies);
+  // Sum of violations max(0, -C) of every source at velocities v (per body).
+  double CalcViolationSum(double h, const std::vector<DeformableBody*>& bodies,
+                          const std::vector<ConstraintSource*>& sources,
+                          const std::vector<VecX>& v);
   // Merit phi at velocities v (per body) with penalty weight rho.
   double CalcMerit(double h, const std::vector<DeformableBody*>& bodies,
                    const std::vector<ConstraintSource*>& sources, const std::vector<VecX>& v,

@@ -17,11 +17,13 @@ struct StepStats {
   int rows_energy = 0;            // active energy-limit rows
   int rows_contact = 0;           // contact normal + friction rows
   int pgs_sweeps = 0;             // total over SQP iterations
-  int sqp_iterations = 0;
+  int active_set_solves = 0;      // QPs refined by a direct active-set solve
+  int sqp_iterations = 0;         // including restoration iterations
+  int restoration_iterations = 0; // push-only iterations after the SQP cap
   double violation_before = 0.0;  // max(0, -C) at the unconstrained prediction x*
   double violation_after = 0.0;   // max(0, -C) at the end of the step
   double stationarity = 0.0;      // ||A(v - v*) - J^T lambda|| / ||J^T lambda|| at the end
-  bool converged = true;          // SQP reached its tolerance (false: stopped at the cap)
+  bool converged = true;          // violation within tolerance at the end (false: caps reached)
 
   int rows_total() const { return rows_strain + rows_energy + rows_contact; }
 };
