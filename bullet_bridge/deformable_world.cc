@@ -64,19 +64,29 @@ DeformableWorld::Entry& DeformableWorld::FindEntry(const DeformableBody* body) {
   throw InputError("deformable body is not in this world");
 }
 
-StrainLimitConstraint* DeformableWorld::SetStrainLimits(DeformableBody* body,
-                                                        const StrainLimitSettings& limits) {
-  Entry& entry = FindEntry(body);
-  auto source = std::make_unique<StrainLimitConstraint>(*body, limits, next_source_id_++);
-  StrainLimitConstraint* result = source.get();
-  auto& sources = entry.sources;
+template <typename T>
+T* DeformableWorld::ReplaceSource(DeformableBody* body, std::unique_ptr<T> source) {
+  auto& sources = FindEntry(body).sources;
   sources.erase(std::remove_if(sources.begin(), sources.end(),
-                               [](const auto& s) {
-                                 return dynamic_cast<StrainLimitConstraint*>(s.get()) != nullptr;
-                               }),
+                               [](const auto& s) { return dynamic_cast<T*>(s.get()) != nullptr; }),
                 sources.end());
+  T* result = source.get();
   sources.push_back(std::move(source));
   return result;
+}
+
+StrainLimitConstraint* DeformableWorld::SetStrainLimits(DeformableBody* body,
+                                                        const StrainLimitSettings& limits) {
+  FindEntry(body);  // names a foreign body before anything is built
+  return ReplaceSource(
+      body, std::make_unique<StrainLimitConstraint>(*body, limits, next_source_id_++));
+}
+
+EnergyLimitConstraint* DeformableWorld::SetEnergyLimits(DeformableBody* body,
+                                                        const EnergyLimitSettings& limits) {
+  FindEntry(body);
+  return ReplaceSource(
+      body, std::make_unique<EnergyLimitConstraint>(*body, limits, next_source_id_++));
 }
 
 void DeformableWorld::ClearLimits(DeformableBody* body) { FindEntry(body).sources.clear(); }
@@ -124,6 +134,9 @@ void DeformableWorld::StepDeformableBodies(double h) {
     stats_.rows_energy += body_stats.rows_energy;
     stats_.pgs_sweeps += body_stats.pgs_sweeps;
     stats_.sqp_iterations = std::max(stats_.sqp_iterations, body_stats.sqp_iterations);
+    stats_.restoration_iterations += body_stats.restoration_iterations;
+    stats_.active_set_solves += body_stats.active_set_solves;
+    stats_.stationarity = std::max(stats_.stationarity, body_stats.stationarity);
     stats_.violation_before = std::max(stats_.violation_before, body_stats.violation_before);
     stats_.violation_after = std::max(stats_.violation_after, body_stats.violation_after);
     stats_.converged = stats_.converged && body_stats.converged;

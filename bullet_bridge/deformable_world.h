@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "bullet_bridge/deformable_collision_object.h"
+#include "constraints/energy_limit_constraint.h"
 #include "constraints/sqp_solver.h"
 #include "constraints/step_stats.h"
 #include "constraints/strain_limit_constraint.h"
@@ -38,6 +39,9 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   // Limits the principal stretches of every tet of `body` (paper A). Replaces earlier strain
   // limits of that body. Throws InputError for invalid settings or a body that is not a tet body.
   StrainLimitConstraint* SetStrainLimits(DeformableBody* body, const StrainLimitSettings& limits);
+  // Limits the elastic energy of every tet of `body` to U_max (paper B: C = 1 - U_e/U_max).
+  // Replaces earlier energy limits of the body; throws InputError for invalid settings.
+  EnergyLimitConstraint* SetEnergyLimits(DeformableBody* body, const EnergyLimitSettings& limits);
   // Removes every constraint source (limits) of the body.
   void ClearLimits(DeformableBody* body);
   // Solver settings used by every constrained body.
@@ -68,6 +72,9 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   };
   // The entry of a body; throws InputError when the body is not in this world.
   Entry& FindEntry(const DeformableBody* body);
+  // Installs `source` on the body's entry, replacing any earlier source of the same type T.
+  template <typename T>
+  T* ReplaceSource(DeformableBody* body, std::unique_ptr<T> source);
 
   std::vector<std::unique_ptr<Entry>> bodies_;
   SqpSettings solver_settings_;

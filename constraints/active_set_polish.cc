@@ -16,12 +16,14 @@ double PolishActiveSet(const MatX& W, const VecX& q, const std::vector<PgsRow>& 
   if (m == 0) return residual;
   const double reg = settings.regularization * W.diagonal().maxCoeff();
   std::vector<int> active;
+  VecX candidate = lambda;
   for (int round = 0; round < settings.max_rounds && residual > settings.tolerance; ++round) {
-    // Active set from the iterate: positive multipliers and violated rows.
-    const VecX w = W * lambda + q;
+    // Primal-dual active set: rows with min(lambda, w) decided by lambda > w (here lambda > 0 or
+    // w < 0 of the current candidate) are active, w_A = 0; the others have lambda = 0.
+    const VecX w = W * candidate + q;
     active.clear();
     for (int c = 0; c < m; ++c)
-      if (lambda[c] > 0.0 || w[c] < 0.0) active.push_back(c);
+      if (candidate[c] - w[c] > 0.0) active.push_back(c);
     if (active.empty()) break;
     const int k = static_cast<int>(active.size());
     MatX W_AA(k, k);
@@ -31,20 +33,22 @@ double PolishActiveSet(const MatX& W, const VecX& q, const std::vector<PgsRow>& 
       for (int b = 0; b < k; ++b) W_AA(a, b) = W(active[a], active[b]);
       W_AA(a, a) += reg;
     }
-    // Direct solve on the active rows; the rest are inactive.
     const VecX lambda_A = W_AA.ldlt().solve(rhs);
     if (!lambda_A.allFinite()) break;
-    VecX candidate = VecX::Zero(m);
+    candidate.setZero();
     for (int a = 0; a < k; ++a) candidate[active[a]] = std::max(0.0, lambda_A[a]);
-    PgsSettings fix = pgs;
-    fix.max_sweeps = settings.sweeps_per_round;
-    const PgsStats stats = SolvePgs(W, q, rows, candidate, fix);
-    if (sweeps != nullptr) *sweeps += stats.sweeps;
+    if (settings.sweeps_per_round > 0) {
+      PgsSettings fix = pgs;
+      fix.max_sweeps = settings.sweeps_per_round;
+      const PgsStats stats = SolvePgs(W, q, rows, candidate, fix);
+      if (sweeps != nullptr) *sweeps += stats.sweeps;
+    }
     const double candidate_residual =
         internal::CalcLcpResidualUnchecked(W, q, rows, candidate).natural_map;
-    if (candidate_residual >= residual) break;  // no progress: keep the better PGS answer
-    lambda = candidate;
-    residual = candidate_residual;
+    if (candidate_residual < residual) {  // keep the best answer seen
+      lambda = candidate;
+      residual = candidate_residual;
+    }
   }
   return residual;
 }

@@ -29,11 +29,13 @@ int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::strin
   std::ofstream csv(out_dir + "/steps.csv");
   csv.precision(17);
   csv << "step,time_s,ms_step,ms_unconstrained,ms_rows,ms_solve,ms_rigid,rows_strain,"
-         "rows_energy,rows_contact,pgs_sweeps,sqp_iterations,violation_before,violation_after";
+         "rows_energy,rows_contact,pgs_sweeps,sqp_iterations,restoration_iterations,active_set_solves,"
+         "violation_before,violation_after,stationarity,converged";
   for (const std::string& column : scene->CsvColumns()) csv << "," << column;
   csv << "\n";
   std::vector<double> ms_steps, values;
-  int max_sqp = 0, total_sweeps = 0;
+  int max_sqp = 0, total_sweeps = 0, unconverged_steps = 0;
+  double total_sqp = 0.0;
   double max_violation = 0.0;
   const auto run_start = std::chrono::steady_clock::now();
   auto last_progress = run_start;
@@ -46,18 +48,21 @@ int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::strin
     ms_steps.push_back(ms);
     const taut::StepStats& s = scene->world().last_step_stats();
     max_sqp = std::max(max_sqp, s.sqp_iterations);
+    total_sqp += s.sqp_iterations;
+    unconverged_steps += s.converged ? 0 : 1;
     total_sweeps += s.pgs_sweeps;
     max_violation = std::max(max_violation, s.violation_after);
     csv << step << "," << step * dt << "," << ms << "," << s.ms_unconstrained << "," << s.ms_rows
         << "," << s.ms_solve << "," << s.ms_rigid << "," << s.rows_strain << "," << s.rows_energy
         << "," << s.rows_contact << "," << s.pgs_sweeps << "," << s.sqp_iterations << ","
-        << s.violation_before << "," << s.violation_after;
+        << s.restoration_iterations << "," << s.active_set_solves << "," << s.violation_before
+        << "," << s.violation_after << "," << s.stationarity << "," << (s.converged ? 1 : 0);
     values.clear();
     scene->AppendCsvValues(values);
     for (double v : values) csv << "," << v;
     csv << "\n";
     if (vtk && step % vtk_every == 0) scene->WriteVtkFrame(out_dir, step / vtk_every);
-    if (std::chrono::duration<double>(t1 - last_progress).count() > 1.0 || step == steps) {
+    if (std::chrono::duration<double>(t1 - last_progress).count() > 2.0 || step == steps) {
       std::fprintf(stderr, "\r%s: step %d/%d (%.0f%%), %.3f ms/step", info.name.c_str(), step,
                    steps, 100.0 * step / steps, Median(ms_steps));
       last_progress = t1;
@@ -74,6 +79,8 @@ int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::strin
       std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
   summary["max_violation"] = max_violation;
   summary["max_sqp_iterations"] = max_sqp;
+  summary["mean_sqp_iterations"] = steps > 0 ? total_sqp / steps : 0.0;
+  summary["unconverged_steps"] = unconverged_steps;
   summary["pgs_sweeps_total"] = total_sweeps;
   char hash[32];
   std::snprintf(hash, sizeof(hash), "%016llx",

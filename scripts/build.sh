@@ -39,9 +39,10 @@ taut_build_release() {
   taut_configure_build build/release -DCMAKE_BUILD_TYPE=Release
 }
 
-# Debug build with AddressSanitizer and UBSan in build/asan (no benchmarks, no demos).
+# Debug build (assertions on, -O1 so Eigen-heavy tests finish) with AddressSanitizer and UBSan
+# in build/asan (no benchmarks, no demos).
 taut_build_asan() {
-  taut_configure_build build/asan -DCMAKE_BUILD_TYPE=Debug -DTAUT_SANITIZE=ON \
+  taut_configure_build build/asan -DCMAKE_BUILD_TYPE=Debug "-DCMAKE_CXX_FLAGS_DEBUG=-g -O1" -DTAUT_SANITIZE=ON \
     -DTAUT_BUILD_BENCH=OFF -DTAUT_BUILD_DEMOS=OFF
 }
 

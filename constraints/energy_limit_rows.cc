@@ -1,0 +1,33 @@
+#include "constraints/energy_limit_rows.h"
+
+#include "plugin/signed_svd.h"
+
+namespace taut {
+
+void CalcEnergyLimitJacobian(const Vec3* forces, int num_nodes, double u_max, Vec3* J) {
+  // dC/dx = -(1/U_max) dU/dx = f / U_max (MATH.md §4).
+  const double scale = 1.0 / u_max;
+  for (int n = 0; n < num_nodes; ++n) J[n] = scale * forces[n];
+}
+
+double CalcTetElementEnergy(const TetRestElement& rest, const LameParameters& lame,
+                            const std::array<Vec3, 4>& x) {
+  const Mat3 G = CalcTetDeformationGradient(rest, x);
+  return CalcCorotatedTetEnergy(rest, lame, G, CalcPolarRotation(G));
+}
+
+TetEnergyLimitRow CalcTetEnergyLimitRow(const TetRestElement& rest, const LameParameters& lame,
+                                        const std::array<Vec3, 4>& x, double u_max) {
+  const Mat3 G = CalcTetDeformationGradient(rest, x);
+  const Mat3 R = CalcPolarRotation(G);
+  TetEnergyLimitRow row;
+  row.energy = CalcCorotatedTetEnergy(rest, lame, G, R);
+  row.C = CalcEnergyLimitValue(row.energy, u_max);
+  const std::array<Vec3, 4> f = CalcCorotatedTetForces(rest, lame, G, R);
+  std::array<Vec3, 4> J;
+  CalcEnergyLimitJacobian(f.data(), 4, u_max, J.data());
+  for (int n = 0; n < 4; ++n) row.J.segment<3>(3 * n) = J[n];
+  return row;
+}
+
+}  // namespace taut

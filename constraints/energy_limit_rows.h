@@ -1,0 +1,34 @@
+// Energy-limit constraint rows (paper B eq. 14; MATH.md §4): per element
+//   C = 1 - U_e / U_max >= 0,   dC/dx = -(1/U_max) dU_e/dx = f_e / U_max,
+// where f_e is the element's elastic force. C = 1 at rest, 0 at the limit, < 0 beyond it.
+// For hexes with R frozen, f_e = -R K_e (R^T x - X) (MATH.md §4 / §6 B4), so any element type only
+// needs its energy and forces. For co-rotated tets with R = polar(G) the force is the exact
+// gradient of U (plugin/corotated_tet_element.h), so the tet Jacobian is exact.
+#pragma once
+
+#include "plugin/corotated_tet_element.h"
+
+namespace taut {
+
+// C = 1 - U/U_max [-]; U_max = +inf gives 1 (unlimited element).
+inline double CalcEnergyLimitValue(double energy, double u_max) { return 1.0 - energy / u_max; }
+
+// dC/dx_n = f_n / U_max for n < num_nodes [1/m]; f are the element's elastic forces [N].
+void CalcEnergyLimitJacobian(const Vec3* forces, int num_nodes, double u_max, Vec3* J);
+
+// Energy limit of one tet, linearised: C(x + dx) ~ C + J . dx.
+struct TetEnergyLimitRow {
+  Vec12 J = Vec12::Zero();  // dC/dx, ordered (x_1, x_2, x_3, x_4) each xyz [1/m]
+  double C = 1.0;           // 1 - U/U_max [-]
+  double energy = 0.0;      // U_e [J]
+};
+
+// Co-rotated energy U_e of a tet at node positions x, with R = polar(G) [J].
+double CalcTetElementEnergy(const TetRestElement& rest, const LameParameters& lame,
+                            const std::array<Vec3, 4>& x);
+
+// C, U_e and the exact Jacobian -grad U / U_max of a tet at node positions x (U_max > 0).
+TetEnergyLimitRow CalcTetEnergyLimitRow(const TetRestElement& rest, const LameParameters& lame,
+                                        const std::array<Vec3, 4>& x, double u_max);
+
+}  // namespace taut

@@ -1,0 +1,108 @@
+#include "plugin/corotated_hex_element.h"
+
+#include "plugin/signed_svd.h"
+
+namespace taut {
+
+namespace {
+// [x_b - x_a, x_c - x_a, x_d - x_a] for inscribed tet t.
+Mat3 TetEdges(const HexNodes& x, int t) {
+  const int* n = kHexInscribedTets[t];
+  Mat3 D;
+  for (int c = 0; c < 3; ++c) D.col(c) = x[n[c + 1]] - x[n[0]];
+  return D;
+}
+}  // namespace
+
+HexRestElement CalcHexRestElement(const HexNodes& X, const LameParameters& lame) {
+  HexRestElement rest;
+  rest.X = X;
+  rest.volume = 0.0;
+  rest.stiffness.setZero();
+  for (int q = 0; q < 8; ++q) {
+    const Vec3 s = HexGaussPoint(q);
+    const Mat3 F = CalcHexJacobian(X, s);
+    const double det = F.determinant();
+    TAUT_DEMAND(det > 0.0, "hex element: det dX/ds = ", det, " <= 0 at Gauss point ", q);
+    rest.gradients[q] = CalcHexShapeGradients(s) * F.inverse();
+    rest.weights[q] = det;
+    rest.volume += det;
+    // K_e += w det F B^T C B; block (a,b) = lambda g_a g_b^T + mu g_b g_a^T + mu (g_a.g_b) I.
+    const HexGradients& g = rest.gradients[q];
+    for (int a = 0; a < 8; ++a)
+      for (int b = 0; b < 8; ++b) {
+        const Vec3 ga = g.row(a).transpose(), gb = g.row(b).transpose();
+        Mat3 K = lame.lambda * ga * gb.transpose() + lame.mu * gb * ga.transpose();
+        K.diagonal().array() += lame.mu * ga.dot(gb);
+        rest.stiffness.block<3, 3>(3 * a, 3 * b) += det * K;
+      }
+  }
+  rest.center_gradients =
+      CalcHexShapeGradients(Vec3::Zero()) * CalcHexJacobian(X, Vec3::Zero()).inverse();
+  for (int t = 0; t < 2; ++t) rest.tet_rest_inverses[t] = TetEdges(X, t).inverse();
+  return rest;
+}
+
+Mat3 CalcHexDeformationGradient(const HexGradients& g, const HexNodes& x) {
+  Mat3 G = Mat3::Zero();
+  for (int a = 0; a < 8; ++a) G += x[a] * g.row(a);
+  return G;
+}
+
+Mat3 CalcHexCenterDeformationGradient(const HexRestElement& rest, const HexNodes& x) {
+  return CalcHexDeformationGradient(rest.center_gradients, x);
+}
+
+Mat3 CalcHexInscribedTetDeformationGradient(const HexRestElement& rest, const HexNodes& x, int t) {
+  TAUT_ASSERT(t == 0 || t == 1);
+  return TetEdges(x, t) * rest.tet_rest_inverses[t];
+}
+
+Mat3 CalcHexRotation(const HexRestElement& rest, const HexNodes& x, HexRotationMethod method) {
+  const Mat3 G = method == HexRotationMethod::kCenterPolar
+                     ? CalcHexCenterDeformationGradient(rest, x)
+                     : CalcHexInscribedTetDeformationGradient(rest, x, 0);
+  return CalcPolarRotation(G);
+}
+
+Mat3 CalcHexGaussStrain(const HexRestElement& rest, const HexNodes& x, const Mat3& R, int q) {
+  const Mat3 RtG = R.transpose() * CalcHexDeformationGradient(rest.gradients[q], x);
+  return 0.5 * (RtG + RtG.transpose()) - Mat3::Identity();
+}
+
+namespace {
+// u = R^T x - X, node-major, taken relative to the centroids (K_e annihilates translations),
+// u_a = R^T (x_a - x_c) - (X_a - X_c), so far-from-origin elements keep full precision.
+Vec24 CorotatedDisplacement(const HexRestElement& rest, const HexNodes& x, const Mat3& R) {
+  Vec3 xc = Vec3::Zero(), Xc = Vec3::Zero();
+  for (int a = 0; a < 8; ++a) {
+    xc += x[a] / 8.0;
+    Xc += rest.X[a] / 8.0;
+  }
+  Vec24 u;
+  for (int a = 0; a < 8; ++a) u.segment<3>(3 * a) = R.transpose() * (x[a] - xc) - (rest.X[a] - Xc);
+  return u;
+}
+}  // namespace
+
+double CalcCorotatedHexEnergy(const HexRestElement& rest, const HexNodes& x, const Mat3& R) {
+  const Vec24 u = CorotatedDisplacement(rest, x, R);
+  return 0.5 * u.dot(rest.stiffness * u);
+}
+
+Vec24 CalcCorotatedHexForces(const HexRestElement& rest, const HexNodes& x, const Mat3& R) {
+  const Vec24 Ku = rest.stiffness * CorotatedDisplacement(rest, x, R);
+  Vec24 f;
+  for (int a = 0; a < 8; ++a) f.segment<3>(3 * a) = -(R * Ku.segment<3>(3 * a));
+  return f;
+}
+
+Mat24 CalcFrozenRotationHexStiffness(const HexRestElement& rest, const Mat3& R) {
+  Mat24 K;
+  for (int a = 0; a < 8; ++a)
+    for (int b = 0; b < 8; ++b)
+      K.block<3, 3>(3 * a, 3 * b) = R * rest.stiffness.block<3, 3>(3 * a, 3 * b) * R.transpose();
+  return K;
+}
+
+}  // namespace taut

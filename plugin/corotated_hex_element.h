@@ -1,0 +1,75 @@
+// Co-rotational linear elasticity on one trilinear hexahedron (paper B with the fixes of
+// MATH.md §4 and §6 B1-B3).
+//
+// With h_qa = (H(s_q) F_q^-1)_a the gradient of N_a w.r.t. the rest coordinates at Gauss point q
+// (F_q = dX/ds there, 2x2x2 rule, weights 1) and u = R^T x - X (24), the element energy is
+//   U = 1/2 u^T K_e u = sum_q det F_q psi(eps_q),  eps_q = sym(R^T G_q) - I,
+//   G_q = sum_a x_a h_qa^T,  psi = mu eps:eps + (lambda/2) tr(eps)^2 = 1/2 eps:C:eps,
+// with K_e = sum_q det F_q B_q^T C B_q (24x24). With R frozen, f = -dU/dx = -R K_e u and
+// -df/dx = R K_e R^T (block diag R). R is the signed polar rotation of G(0), the deformation
+// gradient at the element centre, or (to reproduce the paper) of the inscribed tet {1,4,6,7}.
+// Local node a = paper node n - 1, reference corner HexCornerSign(a) (hex_lattice.h).
+#pragma once
+
+#include <array>
+
+#include "plugin/corotated_tet_element.h"
+#include "plugin/hex_lattice.h"
+
+namespace taut {
+
+using Vec24 = Eigen::Matrix<double, 24, 1>;
+using Mat24 = Eigen::Matrix<double, 24, 24>;
+using HexNodes = std::array<Vec3, 8>;
+using HexGradients = Eigen::Matrix<double, 8, 3>;  // row a = gradient of N_a [1/m]
+
+// How the element rotation is taken (MATH.md §4).
+enum class HexRotationMethod {
+  kCenterPolar,   // R = polar(G(0)): no spurious rotation under bending modes (recommended)
+  kInscribedTet,  // R = polar(G_{1467}) of the inscribed tet (paper B; aliases bending)
+};
+
+// Rest data of one hex, computed once.
+struct HexRestElement {
+  HexNodes X;                             // rest node positions [m]
+  std::array<HexGradients, 8> gradients;  // H(s_q) F_q^-1 at Gauss point q [1/m]
+  std::array<double, 8> weights;          // w_q det F_q, w_q = 1 [m^3]
+  HexGradients center_gradients;          // H(0) F(0)^-1 [1/m]
+  // [X_b - X_a, X_c - X_a, X_d - X_a]^-1 of the inscribed tets {1,4,6,7} and {2,3,5,8} [1/m].
+  std::array<Mat3, 2> tet_rest_inverses;
+  double volume = 0.0;  // sum_q w_q det F_q [m^3]
+  Mat24 stiffness;      // K_e, node-major xyz [N/m]
+};
+
+// Local nodes (0-based) of the inscribed tets: {1,4,6,7} -> {0,3,5,6}, {2,3,5,8} -> {1,2,4,7}.
+inline constexpr int kHexInscribedTets[2][4] = {{0, 3, 5, 6}, {1, 2, 4, 7}};
+
+// Precomputes gradients, weights and K_e of a hex with rest nodes X (throws InputError if
+// det F_q <= 0 at a Gauss point).
+HexRestElement CalcHexRestElement(const HexNodes& X, const LameParameters& lame);
+
+// G = sum_a x_a g_a^T for gradients g (one row per node).
+Mat3 CalcHexDeformationGradient(const HexGradients& g, const HexNodes& x);
+
+// G(0) at the element centre, = 1/2 (G_1467 + G_2358) when the rest hex is a parallelepiped.
+Mat3 CalcHexCenterDeformationGradient(const HexRestElement& rest, const HexNodes& x);
+
+// Affine deformation gradient of inscribed tet t (0: {1,4,6,7}, 1: {2,3,5,8}).
+Mat3 CalcHexInscribedTetDeformationGradient(const HexRestElement& rest, const HexNodes& x, int t);
+
+// Element rotation: signed polar rotation of G(0) or of G_1467 (det R = +1 even when inverted).
+Mat3 CalcHexRotation(const HexRestElement& rest, const HexNodes& x, HexRotationMethod method);
+
+// Co-rotated strain at Gauss point q: eps_q = sym(R^T G_q) - I.
+Mat3 CalcHexGaussStrain(const HexRestElement& rest, const HexNodes& x, const Mat3& R, int q);
+
+// U = 1/2 (R^T x - X)^T K_e (R^T x - X) [J].
+double CalcCorotatedHexEnergy(const HexRestElement& rest, const HexNodes& x, const Mat3& R);
+
+// f = -R K_e (R^T x - X), node-major [N] (= -dU/dx with R frozen).
+Vec24 CalcCorotatedHexForces(const HexRestElement& rest, const HexNodes& x, const Mat3& R);
+
+// Frozen-rotation stiffness R K_e R^T (= -df/dx with R frozen), symmetric PSD [N/m].
+Mat24 CalcFrozenRotationHexStiffness(const HexRestElement& rest, const Mat3& R);
+
+}  // namespace taut

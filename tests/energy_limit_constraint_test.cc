@@ -1,0 +1,235 @@
+#include "constraints/energy_limit_constraint.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "constraints/sqp_solver.h"
+#include "plugin/box_tet_mesher.h"
+#include "tests/test_utils.h"
+
+namespace taut {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// A tet box body named "cube" (no world).
+std::unique_ptr<DeformableBody> MakeCube(double youngs_modulus, int cells, double damping = 2.0) {
+  DeformableBodySettings settings;
+  settings.name = "cube";
+  settings.material = {youngs_modulus, 0.3, 1000.0};
+  settings.mass_damping = damping;
+  auto mesh = std::make_shared<TetMesh>(MakeBoxTetMesh(Vec3(0.1, 0.1, 0.1), cells, cells, cells));
+  return std::make_unique<DeformableBody>(
+      std::make_unique<TetElementModel>(mesh, settings.material), settings);
+}
+
+const TetElementModel& Tets(const DeformableBody& body) {
+  return dynamic_cast<const TetElementModel&>(body.model());
+}
+
+// Rest positions with a smooth nonuniform stretch, so element energies differ.
+VecX Stretched(const DeformableBody& body, double amount) {
+  VecX x = body.model().rest_positions();
+  for (int i = 0; i < body.num_nodes(); ++i) {
+    const double z = x[3 * i + 2];
+    x[3 * i + 2] = z * (1.0 + amount * (1.0 + 10.0 * z));
+    x[3 * i] += 0.3 * amount * z * z * 10.0;
+  }
+  return x;
+}
+
+// U_e of element e at x [J].
+double ElementEnergy(const DeformableBody& body, const VecX& x, int e) {
+  const TetElementModel& tets = Tets(body);
+  return CalcTetElementEnergy(tets.rest().elements[e], tets.lame(), tets.GatherElement(x, e));
+}
+
+TEST(EnergyLimitConstraintTest, RowsAreEmittedExactlyBelowTheMargin) {
+  auto body = MakeCube(2e3, 2);
+  const VecX x = Stretched(*body, 0.1);
+  const int num = body->model().num_elements();
+  double u_lo = kInf, u_hi = 0.0;
+  for (int e = 0; e < num; ++e) {
+    u_lo = std::min(u_lo, ElementEnergy(*body, x, e));
+    u_hi = std::max(u_hi, ElementEnergy(*body, x, e));
+  }
+  ASSERT_GT(u_hi, 2.0 * u_lo);
+  // U_max between the extremes: some elements violate, some are inside the margin, some not.
+  const double u_max = 0.5 * (u_lo + u_hi);
+  EnergyLimitConstraint source(*body, EnergyLimitSettings::PerElementEnergy(u_max), 5);
+  std::vector<ConstraintRow> rows;
+  const int appended = source.AppendRows(x, 3, rows);
+  ASSERT_EQ(appended, static_cast<int>(rows.size()));
+  int expected = 0;
+  double max_violation = 0.0, sum = 0.0;
+  for (int e = 0; e < num; ++e) {
+    const double C = 1.0 - ElementEnergy(*body, x, e) / u_max;
+    max_violation = std::max(max_violation, -C);
+    sum += std::max(0.0, -C);
+    if (C < 0.2) ++expected;
+  }
+  EXPECT_GT(expected, 0);
+  EXPECT_LT(expected, num);
+  EXPECT_EQ(appended, expected);
+  for (const ConstraintRow& row : rows) {
+    const int e = static_cast<int>(row.key & 0xffffffffffffULL);
+    EXPECT_EQ(row.key >> 48, 5u);
+    EXPECT_EQ(row.body, 3);
+    EXPECT_EQ(row.type, RowType::kEnergyLimit);
+    EXPECT_EQ(row.num_nodes, 4);
+    EXPECT_LT(row.C, 0.2);
+    EXPECT_NEAR(row.C, 1.0 - ElementEnergy(*body, x, e) / u_max, 1e-12);
+    for (int n = 0; n < 4; ++n) EXPECT_EQ(row.nodes[n], Tets(*body).element_nodes(e)[n]);
+  }
+  EXPECT_GT(max_violation, 0.0);
+  EXPECT_NEAR(source.CalcMaxViolation(x), max_violation, 1e-12);
+  EXPECT_NEAR(source.CalcViolationSum(x), sum, 1e-12);
+  EXPECT_NEAR(source.CalcMaxEnergyRatio(x), u_hi / u_max, 1e-12);
+  // No rows and no violation at rest.
+  rows.clear();
+  EXPECT_EQ(source.AppendRows(body->model().rest_positions(), 0, rows), 0);
+  EXPECT_EQ(source.CalcMaxViolation(body->model().rest_positions()), 0.0);
+}
+
+TEST(EnergyLimitConstraintTest, RowJacobianMatchesFiniteDifferencesOfTheBodyEnergyRatio) {
+  auto body = MakeCube(2e3, 1);
+  const VecX x = Stretched(*body, 0.1);
+  EnergyLimitConstraint source(*body, EnergyLimitSettings::PerElementEnergy(1e-9), 0);
+  std::vector<ConstraintRow> rows;
+  source.AppendRows(x, 0, rows);
+  ASSERT_EQ(rows.size(), 6u);
+  for (const ConstraintRow& row : rows) {
+    const int e = static_cast<int>(row.key);
+    VecX J = VecX::Zero(x.size());
+    for (int n = 0; n < row.num_nodes; ++n) J.segment<3>(3 * row.nodes[n]) = row.J[n];
+    const MatX fd = testing::CentralDifference(
+        [&](const VecX& y) { return VecX::Constant(1, 1.0 - ElementEnergy(*body, y, e) / 1e-9); },
+        x, 1e-7);
+    ASSERT_GT(fd.norm(), 1.0);
+    EXPECT_LT(testing::RelativeError(J.transpose(), fd), 1e-6) << "element " << e;
+  }
+}
+
+TEST(EnergyLimitConstraintTest, EnergyDensityIsMultipliedByTheRestVolume) {
+  auto body = MakeCube(2e3, 2);
+  const double density = 3.0;  // J/m^3
+  EnergyLimitConstraint source(*body, EnergyLimitSettings::EnergyDensity(density), 0);
+  const TetElementModel& tets = Tets(*body);
+  const double cell_tet_volume = std::pow(0.05, 3) / 6.0;  // Kuhn tets: 1/6 of a 5 cm cube
+  for (int e = 0; e < tets.num_elements(); ++e) {
+    EXPECT_NEAR(source.element_limits()[e], density * tets.rest().elements[e].volume, 1e-18);
+    EXPECT_NEAR(source.element_limits()[e], density * cell_tet_volume, 1e-15);
+  }
+  const VecX x = Stretched(*body, 0.1);
+  std::vector<ConstraintRow> rows;
+  source.AppendRows(x, 0, rows);
+  ASSERT_FALSE(rows.empty());
+  const int e = static_cast<int>(rows[0].key);
+  EXPECT_NEAR(rows[0].C, 1.0 - ElementEnergy(*body, x, e) / (density * cell_tet_volume), 1e-12);
+}
+
+TEST(EnergyLimitConstraintTest, PerElementLimitsAndUnlimitedElements) {
+  auto body = MakeCube(2e3, 1);
+  const VecX x = Stretched(*body, 0.1);
+  EnergyLimitSettings settings;
+  settings.element_u_max.assign(6, kInf);
+  settings.element_u_max[2] = 1e-9;
+  settings.element_u_max[4] = 1e-9;
+  EnergyLimitConstraint source(*body, settings, 1);
+  std::vector<ConstraintRow> rows;
+  ASSERT_EQ(source.AppendRows(x, 0, rows), 2);
+  EXPECT_EQ(rows[0].key & 0xff, 2u);
+  EXPECT_EQ(rows[1].key & 0xff, 4u);
+  EXPECT_NEAR(source.CalcMaxEnergyRatio(x),
+              std::max(ElementEnergy(*body, x, 2), ElementEnergy(*body, x, 4)) / 1e-9, 1e-6);
+}
+
+// Expects InputError whose message contains every one of `parts`.
+void ExpectInputError(const std::function<void()>& f, const std::vector<std::string>& parts) {
+  try {
+    f();
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& error) {
+    for (const std::string& part : parts)
+      EXPECT_NE(std::string(error.what()).find(part), std::string::npos)
+          << "'" << part << "' missing in: " << error.what();
+  }
+}
+
+TEST(EnergyLimitConstraintTest, BadSettingsThrowNamingBodyElementAndRange) {
+  auto body = MakeCube(2e3, 1);
+  auto make = [&](const EnergyLimitSettings& s) { EnergyLimitConstraint source(*body, s, 0); };
+  ExpectInputError([&] { make(EnergyLimitSettings()); },
+                   {"body 'cube' energy limits", "u_max = 0", "(0, +inf]"});
+  ExpectInputError([&] { make(EnergyLimitSettings::PerElementEnergy(-1.0)); },
+                   {"cube", "u_max = -1 J", "(0, +inf]"});
+  ExpectInputError([&] { make(EnergyLimitSettings::EnergyDensity(std::nan(""))); },
+                   {"cube", "nan J/m^3", "(0, +inf]"});
+  EnergyLimitSettings per_element;
+  per_element.element_u_max.assign(5, 1.0);
+  ExpectInputError([&] { make(per_element); },
+                   {"cube", "5 per-element energy limits given for 6 elements"});
+  per_element.element_u_max.assign(6, 1.0);
+  per_element.element_u_max[3] = 0.0;
+  ExpectInputError([&] { make(per_element); }, {"cube", "element 3", "(0, +inf]"});
+  EnergyLimitSettings margin = EnergyLimitSettings::PerElementEnergy(1.0);
+  margin.activation_margin = -0.1;
+  ExpectInputError([&] { make(margin); }, {"cube", "activation_margin = -0.1", "[0, +inf]"});
+  ExpectInputError(
+      [&] { EnergyLimitConstraint(*body, EnergyLimitSettings::PerElementEnergy(1), 1 << 16); },
+      {"source id"});
+  EXPECT_NO_THROW(make(EnergyLimitSettings::PerElementEnergy(kInf)));
+}
+
+// The 0.1 m cube hanging from its top face with a load on its bottom nodes, stepped with the SQP
+// solver (no world). Returns the final height; `max_ratio` gets the largest U_e/U_max after any
+// step (measured with `limit`'s U_max even when the run is unlimited).
+double RunHangingCube(bool limited, double density_limit, double* max_ratio, int* rows) {
+  auto body = MakeCube(2e3, 2);
+  body->FixNodesWhere([](const Vec3& X) { return X.z() > 0.1 - 1e-9; });
+  std::vector<int> bottom;
+  for (int i = 0; i < body->num_nodes(); ++i)
+    if (body->model().rest_positions()[3 * i + 2] < 1e-9) bottom.push_back(i);
+  EnergyLimitConstraint limit(*body, EnergyLimitSettings::EnergyDensity(density_limit), 0);
+  std::vector<ConstraintSource*> sources;
+  if (limited) sources.push_back(&limit);
+  SqpSolver solver;
+  const SqpSettings settings;
+  const double h = 1.0 / 240.0;
+  *max_ratio = 0.0;
+  *rows = 0;
+  for (int step = 0; step < 200; ++step) {
+    for (int i : bottom) body->AddNodeForce(i, Vec3(0, 0, -2.0));
+    body->BeginStep(h, Vec3(0, 0, -9.81));
+    StepStats stats;
+    solver.Solve(h, {body.get()}, sources, settings, stats);
+    body->EndStep(h);
+    *rows = std::max(*rows, stats.rows_energy);
+    *max_ratio = std::max(*max_ratio, limit.CalcMaxEnergyRatio(body->x()));
+  }
+  double z = 0.0;
+  for (int i : bottom) z += body->node_position(i).z();
+  return 0.1 - z / static_cast<double>(bottom.size());
+}
+
+TEST(EnergyLimitConstraintTest, HangingCubeKeepsEveryElementBelowItsEnergyLimit) {
+  const double density_limit = 20.0;  // J/m^3 (about 8 % uniaxial strain at E = 2 kPa)
+  double free_ratio = 0.0, limited_ratio = 0.0;
+  int free_rows = 0, limited_rows = 0;
+  const double free_height = RunHangingCube(false, density_limit, &free_ratio, &free_rows);
+  const double limited_height = RunHangingCube(true, density_limit, &limited_ratio, &limited_rows);
+  std::printf(
+      "hanging cube: unlimited height %.4f m, max U/Umax %.2f; limited height %.4f m, "
+      "max U/Umax %.5f, max rows %d\n",
+      free_height, free_ratio, limited_height, limited_ratio, limited_rows);
+  EXPECT_GT(free_ratio, 10.0);
+  EXPECT_LE(limited_ratio, 1.0 + 1e-2);
+  EXPECT_GT(limited_rows, 0);
+  EXPECT_GT(free_height - 0.1, 3.0 * (limited_height - 0.1));
+  EXPECT_GT(limited_height, 0.1);
+}
+
+}  // namespace
+}  // namespace taut

@@ -1,0 +1,145 @@
+#include "constraints/energy_limit_rows.h"
+
+#include <gtest/gtest.h>
+
+#include "plugin/material.h"
+#include "tests/test_utils.h"
+
+namespace taut {
+namespace {
+
+using testing::CentralDifference;
+using testing::RandomRotation;
+using testing::RelativeError;
+
+// Rest data of one tet with the given rest nodes (positive orientation).
+TetRestElement MakeRest(const std::array<Vec3, 4>& X) {
+  TetMesh mesh;
+  mesh.nodes.assign(X.begin(), X.end());
+  mesh.tets = {{0, 1, 2, 3}};
+  return CalcTetRestData(mesh).elements[0];
+}
+
+// A positively oriented random rest tet near the unit corner tet, scaled to ~0.1 m.
+std::array<Vec3, 4> RandomRestTet(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-0.15, 0.15);
+  std::array<Vec3, 4> X = {Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1), Vec3(0, 0, 0)};
+  for (Vec3& p : X) p = 0.1 * (p + Vec3(u(rng), u(rng), u(rng)));
+  return X;
+}
+
+LameParameters TestLame() {
+  const Material material{2e3, 0.3, 1000.0};
+  return {material.mu(), material.lambda()};
+}
+
+VecX Flatten(const std::array<Vec3, 4>& x) {
+  VecX v(12);
+  for (int n = 0; n < 4; ++n) v.segment<3>(3 * n) = x[n];
+  return v;
+}
+
+std::array<Vec3, 4> Unflatten(const VecX& v) {
+  return {v.segment<3>(0), v.segment<3>(3), v.segment<3>(6), v.segment<3>(9)};
+}
+
+// Maps the rest tet by x = Q (A X) + t with A = I + amplitude * noise, optionally mirrored
+// (inverted: det G < 0).
+std::array<Vec3, 4> Deform(const std::array<Vec3, 4>& X, double amplitude, bool invert,
+                           std::mt19937& rng) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  Mat3 A = Mat3::Identity();
+  for (int i = 0; i < 9; ++i) A.data()[i] += amplitude * n(rng);
+  if (invert) A.row(2) *= -1.0;
+  const Mat3 Q = RandomRotation(rng);
+  const Vec3 t(n(rng), n(rng), n(rng));
+  std::array<Vec3, 4> x;
+  for (int k = 0; k < 4; ++k) x[k] = Q * (A * X[k]) + 0.1 * t;
+  return x;
+}
+
+TEST(EnergyLimitRowsTest, JacobianMatchesCentralDifferences) {
+  std::mt19937 rng(7);
+  const LameParameters lame = TestLame();
+  double worst = 0.0;
+  int inverted = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const auto X = RandomRestTet(rng);
+    const TetRestElement rest = MakeRest(X);
+    const bool invert = trial % 3 == 0;
+    const double amplitude = trial % 2 == 0 ? 0.05 : 0.3;
+    const auto x = Deform(X, amplitude, invert, rng);
+    if (CalcTetDeformationGradient(rest, x).determinant() < 0.0) ++inverted;
+    const double u_max = 1e-4;
+    const TetEnergyLimitRow row = CalcTetEnergyLimitRow(rest, lame, x, u_max);
+    const MatX fd = CentralDifference(
+        [&](const VecX& v) {
+          return VecX::Constant(1, CalcTetEnergyLimitRow(rest, lame, Unflatten(v), u_max).C);
+        },
+        Flatten(x), 1e-7);
+    ASSERT_GT(fd.norm(), 1e-3) << "trial " << trial;
+    ASSERT_GT(row.J.norm(), 1e-3) << "trial " << trial;
+    const double error = RelativeError(row.J.transpose(), fd);
+    worst = std::max(worst, error);
+    EXPECT_LT(error, 1e-5) << "trial " << trial << " invert " << invert;
+  }
+  EXPECT_GT(inverted, 50);
+  std::printf(
+      "energy-limit Jacobian vs FD: worst relative error %.2e over 300 tets (%d inverted)\n", worst,
+      inverted);
+}
+
+TEST(EnergyLimitRowsTest, RestAndRigidMotionGiveOneAndZeroJacobian) {
+  std::mt19937 rng(3);
+  const auto X = RandomRestTet(rng);
+  const TetRestElement rest = MakeRest(X);
+  const TetEnergyLimitRow at_rest = CalcTetEnergyLimitRow(rest, TestLame(), X, 1e-5);
+  EXPECT_EQ(at_rest.C, 1.0);
+  EXPECT_LT(at_rest.J.norm(), 1e-6);
+  const Mat3 Q = RandomRotation(rng);
+  std::array<Vec3, 4> x;
+  for (int n = 0; n < 4; ++n) x[n] = Q * X[n] + Vec3(0.3, -0.2, 1.0);
+  const TetEnergyLimitRow rigid = CalcTetEnergyLimitRow(rest, TestLame(), x, 1e-5);
+  EXPECT_NEAR(rigid.C, 1.0, 1e-9);
+  EXPECT_LT(rigid.J.norm(), 1e-3);  // vs ~1e3 /m for a strained tet at this U_max
+}
+
+TEST(EnergyLimitRowsTest, ZeroExactlyAtTheLimitAndQuadraticInStretch) {
+  std::mt19937 rng(11);
+  const auto X = RandomRestTet(rng);
+  const TetRestElement rest = MakeRest(X);
+  const LameParameters lame = TestLame();
+  // Uniaxial stretch G = diag(1 + e, 1, 1): U = V (mu + lambda/2) e^2.
+  auto stretched = [&](double e) {
+    std::array<Vec3, 4> x = X;
+    for (Vec3& p : x) p.x() *= 1.0 + e;
+    return x;
+  };
+  const double e = 0.04;
+  const double U = rest.volume * (lame.mu + 0.5 * lame.lambda) * e * e;
+  EXPECT_NEAR(CalcTetElementEnergy(rest, lame, stretched(e)), U, 1e-12 * U + 1e-18);
+  const double u_at = CalcTetElementEnergy(rest, lame, stretched(e));
+  EXPECT_EQ(CalcTetEnergyLimitRow(rest, lame, stretched(e), u_at).C, 0.0);
+  // Half the strain: a quarter of the energy, C = 3/4; twice: C = -3.
+  EXPECT_NEAR(CalcTetEnergyLimitRow(rest, lame, stretched(e / 2), u_at).C, 0.75, 1e-9);
+  EXPECT_NEAR(CalcTetEnergyLimitRow(rest, lame, stretched(2 * e), u_at).C, -3.0, 1e-9);
+  // J = f / U_max: along the stretch the row decreases (J . dx < 0 for more stretch).
+  const TetEnergyLimitRow row = CalcTetEnergyLimitRow(rest, lame, stretched(e), u_at);
+  VecX dx(12);
+  for (int n = 0; n < 4; ++n) dx.segment<3>(3 * n) = Vec3(X[n].x(), 0, 0);
+  // dx moves node n by X_n.x along x, i.e. de = 1; dC/de = -(dU/de)/U_max = -2 U/(e U_max) = -2/e.
+  EXPECT_NEAR(row.J.dot(dx), -2.0 / e, 1e-9);
+}
+
+TEST(EnergyLimitRowsTest, GenericJacobianIsForceOverLimit) {
+  const std::array<Vec3, 2> f = {Vec3(1, -2, 3), Vec3(-4, 5, 0.5)};
+  std::array<Vec3, 2> J;
+  CalcEnergyLimitJacobian(f.data(), 2, 0.25, J.data());
+  EXPECT_EQ(J[0], Vec3(4, -8, 12));
+  EXPECT_EQ(J[1], Vec3(-16, 20, 2));
+  EXPECT_EQ(CalcEnergyLimitValue(0.1, 0.4), 0.75);
+  EXPECT_EQ(CalcEnergyLimitValue(5.0, std::numeric_limits<double>::infinity()), 1.0);
+}
+
+}  // namespace
+}  // namespace taut
