@@ -48,6 +48,19 @@ DeformableBody* DeformableWorld::AddTetBody(std::shared_ptr<const TetMesh> mesh,
   return AddDeformableBody(std::make_unique<DeformableBody>(std::move(model), settings));
 }
 
+DeformableBody* DeformableWorld::AddHexBody(const HexLattice& lattice,
+                                            const DeformableBodySettings& settings,
+                                            HexRotationMethod method) {
+  return AddHexBody(std::make_shared<const HexLattice>(lattice), settings, method);
+}
+
+DeformableBody* DeformableWorld::AddHexBody(std::shared_ptr<const HexLattice> lattice,
+                                            const DeformableBodySettings& settings,
+                                            HexRotationMethod method) {
+  auto model = std::make_unique<HexElementModel>(std::move(lattice), settings.material, method);
+  return AddDeformableBody(std::make_unique<DeformableBody>(std::move(model), settings));
+}
+
 DeformableBody* DeformableWorld::AddDeformableBody(std::unique_ptr<DeformableBody> body) {
   TAUT_DEMAND(body != nullptr, "AddDeformableBody: body is null");
   auto entry = std::make_unique<Entry>();

@@ -12,6 +12,7 @@
 #include "constraints/sqp_solver.h"
 #include "constraints/step_stats.h"
 #include "constraints/strain_limit_constraint.h"
+#include "plugin/hex_element_model.h"
 #include "plugin/tet_mesh.h"
 
 namespace taut {
@@ -31,6 +32,13 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   DeformableBody* AddTetBody(const TetMesh& mesh, const DeformableBodySettings& settings);
   DeformableBody* AddTetBody(std::shared_ptr<const TetMesh> mesh,
                              const DeformableBodySettings& settings);
+  // Makes a co-rotational hex body from a lattice (validated; throws InputError) and adds it;
+  // `method` picks the element rotation (MATH.md §4). Ownership as for AddTetBody.
+  DeformableBody* AddHexBody(const HexLattice& lattice, const DeformableBodySettings& settings,
+                             HexRotationMethod method = HexRotationMethod::kCenterPolar);
+  DeformableBody* AddHexBody(std::shared_ptr<const HexLattice> lattice,
+                             const DeformableBodySettings& settings,
+                             HexRotationMethod method = HexRotationMethod::kCenterPolar);
   // Adds a body built elsewhere (any ElementModel).
   DeformableBody* AddDeformableBody(std::unique_ptr<DeformableBody> body);
   // Removes and destroys the body.

@@ -1,4 +1,4 @@
-// Energy limits of one tet body as a source of SQP rows (paper B eq. 14; MATH.md §4-§5).
+// Energy limits of one tet or hex body as a source of SQP rows (paper B eq. 14; MATH.md §4-§5).
 #pragma once
 
 #include <vector>
@@ -6,15 +6,17 @@
 #include "constraints/constraint_row.h"
 #include "constraints/energy_limit_rows.h"
 #include "constraints/energy_limits.h"
+#include "plugin/hex_element_model.h"
 #include "plugin/tet_element_model.h"
 
 namespace taut {
 
-// Emits one row C = 1 - U_e/U_max,e per tet whose C is below the activation margin.
-// A hex version only changes the element kernels (energy and forces) in the private helpers.
+// Emits one row C = 1 - U_e/U_max,e per element (tet: 4 nodes, exact gradient; hex: 8 nodes,
+// J = f_e/U_max with the element rotation frozen at x, MATH.md §4) whose C is below the activation
+// margin.
 class EnergyLimitConstraint final : public ConstraintSource {
  public:
-  // `body` must be a tet body; settings are validated (throws InputError naming the body).
+  // `body` must be a tet or hex body; settings are validated (throws InputError naming the body).
   // `source_id` (< 2^16) makes row keys unique among the sources of a world.
   EnergyLimitConstraint(const DeformableBody& body, const EnergyLimitSettings& settings,
                         int source_id);
@@ -33,9 +35,14 @@ class EnergyLimitConstraint final : public ConstraintSource {
  private:
   // U_e / U_max,e of element e at x (0 for an unlimited element).
   double CalcElementRatio(const VecX& x, int e) const;
+  // U_e of element e at x (rotation recomputed from x) [J].
+  double CalcElementEnergy(const VecX& x, int e) const;
+  // Fills C, the element's nodes and J of the row of element e at x.
+  void FillRow(const VecX& x, int e, ConstraintRow& row) const;
 
   const DeformableBody& body_;
-  const TetElementModel& tets_;
+  const TetElementModel* tets_;   // exactly one of tets_, hexes_ is set
+  const HexElementModel* hexes_;
   EnergyLimitSettings settings_;
   std::vector<double> u_max_;  // U_max,e [J], +inf = unlimited
   std::uint64_t key_prefix_;

@@ -30,4 +30,23 @@ TetEnergyLimitRow CalcTetEnergyLimitRow(const TetRestElement& rest, const LamePa
   return row;
 }
 
+double CalcHexElementEnergy(const HexRestElement& rest, const HexNodes& x,
+                            HexRotationMethod method) {
+  return CalcCorotatedHexEnergy(rest, x, CalcHexRotation(rest, x, method));
+}
+
+HexEnergyLimitRow CalcHexEnergyLimitRow(const HexRestElement& rest, const HexNodes& x,
+                                        const Mat3& R, double u_max) {
+  HexEnergyLimitRow row;
+  row.energy = CalcCorotatedHexEnergy(rest, x, R);
+  row.C = CalcEnergyLimitValue(row.energy, u_max);
+  // J = f_e / U_max with f_e = -R K_e (R^T x - X) (MATH.md §4, frozen R).
+  const Vec24 f = CalcCorotatedHexForces(rest, x, R);
+  std::array<Vec3, 8> forces, J;
+  for (int n = 0; n < 8; ++n) forces[n] = f.segment<3>(3 * n);
+  CalcEnergyLimitJacobian(forces.data(), 8, u_max, J.data());
+  for (int n = 0; n < 8; ++n) row.J.segment<3>(3 * n) = J[n];
+  return row;
+}
+
 }  // namespace taut

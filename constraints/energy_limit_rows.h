@@ -6,6 +6,7 @@
 // gradient of U (plugin/corotated_tet_element.h), so the tet Jacobian is exact.
 #pragma once
 
+#include "plugin/corotated_hex_element.h"
 #include "plugin/corotated_tet_element.h"
 
 namespace taut {
@@ -30,5 +31,21 @@ double CalcTetElementEnergy(const TetRestElement& rest, const LameParameters& la
 // C, U_e and the exact Jacobian -grad U / U_max of a tet at node positions x (U_max > 0).
 TetEnergyLimitRow CalcTetEnergyLimitRow(const TetRestElement& rest, const LameParameters& lame,
                                         const std::array<Vec3, 4>& x, double u_max);
+
+// Energy limit of one hex, linearised with the element rotation R frozen: C(x + dx) ~ C + J . dx.
+struct HexEnergyLimitRow {
+  Vec24 J = Vec24::Zero();  // dC/dx = f_e / U_max, node-major (local hex order) xyz [1/m]
+  double C = 1.0;           // 1 - U/U_max [-]
+  double energy = 0.0;      // U_e [J]
+};
+
+// Co-rotated energy U_e = 1/2 (R^T x - X)^T K_e (R^T x - X) of a hex, R from x by `method` [J].
+double CalcHexElementEnergy(const HexRestElement& rest, const HexNodes& x,
+                            HexRotationMethod method);
+
+// C, U_e and J = f_e/U_max = -R K_e (R^T x - X)/U_max of a hex with R frozen (MATH.md §4),
+// the exact gradient of C(x) = 1 - U(x, R)/U_max for fixed R (U_max > 0).
+HexEnergyLimitRow CalcHexEnergyLimitRow(const HexRestElement& rest, const HexNodes& x,
+                                        const Mat3& R, double u_max);
 
 }  // namespace taut

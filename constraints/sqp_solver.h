@@ -15,6 +15,7 @@ namespace taut {
 inline PgsSettings DefaultPgs() {
   PgsSettings pgs;
   pgs.max_sweeps = 100;
+  pgs.tolerance = 1e-4;  // in w units (1/s): C error h * 1e-4, far below the SQP tolerance
   return pgs;
 }
 

@@ -2,7 +2,9 @@
 
 #include <cstring>
 
+#include "plugin/hex_element_model.h"
 #include "plugin/tet_element_model.h"
+#include "plugin/vtk_hex_writer.h"
 #include "plugin/vtk_writer.h"
 
 namespace taut {
@@ -13,12 +15,17 @@ void Scene::WriteVtkFrame(const std::string& dir, int frame) const {
   for (int b = 0; b < world().num_deformable_bodies(); ++b) {
     const DeformableBody& body = world().deformable_body(b);
     const auto* tets = dynamic_cast<const TetElementModel*>(&body.model());
-    if (tets == nullptr) continue;
+    const auto* hexes = dynamic_cast<const HexElementModel*>(&body.model());
+    if (tets == nullptr && hexes == nullptr) continue;
     std::vector<Vec3> positions(body.num_nodes());
     for (int i = 0; i < body.num_nodes(); ++i) positions[i] = body.node_position(i);
     char name[64];
     std::snprintf(name, sizeof(name), "_%06d.vtk", frame);
-    WriteVtkMesh(dir + "/" + body.name() + name, tets->mesh(), &positions);
+    if (tets != nullptr) {
+      WriteVtkMesh(dir + "/" + body.name() + name, tets->mesh(), &positions);
+    } else {
+      WriteVtkHexLattice(dir + "/" + body.name() + name, hexes->lattice(), &positions);
+    }
   }
 }
 

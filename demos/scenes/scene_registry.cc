@@ -1,3 +1,4 @@
+#include "demos/scenes/hex_beam_scene.h"
 #include "demos/scenes/scene.h"
 #include "demos/scenes/tet_beam_scene.h"
 #include "demos/scenes/vertical_beam_scene.h"
@@ -15,6 +16,11 @@ const std::vector<SceneInfo>& SceneRegistry() {
        "paper A Fig. 4 column (10 kPa) collapsing, x limited to 5 %, in all four projection modes",
        480, 1.0 / 240.0,
        [] { return std::make_unique<VerticalBeamScene>(VerticalBeamScene::AllModes()); }},
+      {"hex_beam",
+       "paper B Fig. 3 cylindrical 56-hex beams: 150 kPa linear, U_e <= 1.0 / 0.5 / 0.1 J, "
+       "2 MPa linear",
+       480, 1.0 / 240.0,
+       [] { return std::make_unique<HexBeamScene>(HexBeamScene::DefaultBeams()); }},
   };
   return scenes;
 }
