@@ -16,39 +16,51 @@ double PolishActiveSet(const MatX& W, const VecX& q, const std::vector<PgsRow>& 
   if (m == 0) return residual;
   const double reg = settings.regularization * W.diagonal().maxCoeff();
   std::vector<int> active;
-  VecX candidate = lambda;
+  VecX candidate(m), trial(m);
+  // Objective of the unilateral LCP as a bound-constrained QP: f = 1/2 l^T W l + q^T l.
+  auto objective = [&](const VecX& l) { return 0.5 * l.dot(W * l) + q.dot(l); };
+  double f = objective(lambda);
   for (int round = 0; round < settings.max_rounds && residual > settings.tolerance; ++round) {
-    // Primal-dual active set: rows with min(lambda, w) decided by lambda > w (here lambda > 0 or
-    // w < 0 of the current candidate) are active, w_A = 0; the others have lambda = 0.
-    const VecX w = W * candidate + q;
+    // Free set: positive multipliers, and zero ones whose gradient w pushes them up.
+    const VecX w = W * lambda + q;
     active.clear();
     for (int c = 0; c < m; ++c)
-      if (candidate[c] - w[c] > 0.0) active.push_back(c);
+      if (lambda[c] > 0.0 || w[c] < 0.0) active.push_back(c);
     if (active.empty()) break;
     const int k = static_cast<int>(active.size());
-    MatX W_AA(k, k);
+    MatX W_FF(k, k);
     VecX rhs(k);
     for (int a = 0; a < k; ++a) {
-      rhs[a] = -q[active[a]];
-      for (int b = 0; b < k; ++b) W_AA(a, b) = W(active[a], active[b]);
-      W_AA(a, a) += reg;
+      rhs[a] = -w[active[a]];
+      for (int b = 0; b < k; ++b) W_FF(a, b) = W(active[a], active[b]);
+      W_FF(a, a) += reg;
     }
-    const VecX lambda_A = W_AA.ldlt().solve(rhs);
-    if (!lambda_A.allFinite()) break;
-    candidate.setZero();
-    for (int a = 0; a < k; ++a) candidate[active[a]] = std::max(0.0, lambda_A[a]);
+    // Newton direction on the free set, then a projected backtracking search on f
+    // (bound-constrained projected Newton): f never increases, so the refinement cannot diverge.
+    const VecX d = W_FF.ldlt().solve(rhs);
+    if (!d.allFinite()) break;
+    double t = 1.0;
+    bool accepted = false;
+    for (int halving = 0; halving < 12 && !accepted; ++halving, t *= 0.5) {
+      trial = lambda;
+      for (int a = 0; a < k; ++a) trial[active[a]] = std::max(0.0, lambda[active[a]] + t * d[a]);
+      const double f_trial = objective(trial);
+      if (f_trial < f) {
+        accepted = true;
+        candidate = trial;
+        f = f_trial;
+      }
+    }
+    if (!accepted) break;
     if (settings.sweeps_per_round > 0) {
       PgsSettings fix = pgs;
       fix.max_sweeps = settings.sweeps_per_round;
       const PgsStats stats = SolvePgs(W, q, rows, candidate, fix);
       if (sweeps != nullptr) *sweeps += stats.sweeps;
+      f = objective(candidate);
     }
-    const double candidate_residual =
-        internal::CalcLcpResidualUnchecked(W, q, rows, candidate).natural_map;
-    if (candidate_residual < residual) {  // keep the best answer seen
-      lambda = candidate;
-      residual = candidate_residual;
-    }
+    lambda = candidate;
+    residual = internal::CalcLcpResidualUnchecked(W, q, rows, lambda).natural_map;
   }
   return residual;
 }

@@ -43,7 +43,8 @@ EnergyLimitConstraint::EnergyLimitConstraint(const DeformableBody& body,
 
 double EnergyLimitConstraint::CalcElementEnergy(const VecX& x, int e) const {
   if (tets_ != nullptr)
-    return CalcTetElementEnergy(tets_->rest().elements[e], tets_->lame(), tets_->GatherElement(x, e));
+    return CalcTetElementEnergy(tets_->rest().elements[e], tets_->lame(),
+                                tets_->GatherElement(x, e));
   return CalcHexElementEnergy(hexes_->rest(e), hexes_->GatherElement(x, e),
                               hexes_->rotation_method());
 }
@@ -51,9 +52,8 @@ double EnergyLimitConstraint::CalcElementEnergy(const VecX& x, int e) const {
 void EnergyLimitConstraint::FillRow(const VecX& x, int e, ConstraintRow& row) const {
   const int* nodes = body_.model().element_nodes(e);
   if (tets_ != nullptr) {
-    const TetEnergyLimitRow r =
-        CalcTetEnergyLimitRow(tets_->rest().elements[e], tets_->lame(), tets_->GatherElement(x, e),
-                              u_max_[e]);
+    const TetEnergyLimitRow r = CalcTetEnergyLimitRow(tets_->rest().elements[e], tets_->lame(),
+                                                      tets_->GatherElement(x, e), u_max_[e]);
     row.C = r.C;
     row.num_nodes = 4;
     for (int n = 0; n < 4; ++n) {

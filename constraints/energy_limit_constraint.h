@@ -41,7 +41,7 @@ class EnergyLimitConstraint final : public ConstraintSource {
   void FillRow(const VecX& x, int e, ConstraintRow& row) const;
 
   const DeformableBody& body_;
-  const TetElementModel* tets_;   // exactly one of tets_, hexes_ is set
+  const TetElementModel* tets_;  // exactly one of tets_, hexes_ is set
   const HexElementModel* hexes_;
   EnergyLimitSettings settings_;
   std::vector<double> u_max_;  // U_max,e [J], +inf = unlimited

@@ -16,9 +16,7 @@ struct Grid {
   double h = 0.0;
   int n[3] = {0, 0, 0};
   // Centre of cell (i, j, k).
-  Vec3 Centre(int i, int j, int k) const {
-    return origin + h * Vec3(i + 0.5, j + 0.5, k + 0.5);
-  }
+  Vec3 Centre(int i, int j, int k) const { return origin + h * Vec3(i + 0.5, j + 0.5, k + 0.5); }
 };
 
 // Grid over bounds with cells of edge h, centred on the bounds.
@@ -77,8 +75,9 @@ HexLattice BuildLattice(const Grid& g, const std::vector<char>& kept, const std:
             hex[a] = compact[node_id(i + ((a >> 2) & 1), j + ((a >> 1) & 1), k + (a & 1))];
           lattice.hexes.push_back(hex);
         }
-  TAUT_DEMAND(!lattice.hexes.empty(), source, ": no cell centre lies inside the shape at cell size ",
-              g.h, " m (grid ", nx, "x", ny, "x", nz, ")");
+  TAUT_DEMAND(!lattice.hexes.empty(), source,
+              ": no cell centre lies inside the shape at cell size ", g.h, " m (grid ", nx, "x", ny,
+              "x", nz, ")");
   return lattice;
 }
 

@@ -55,10 +55,10 @@ SurfaceMesh ReadObjSurface(const std::string& path) {
       for (int a = 0; a < 3; ++a) {
         t[a] = indices[offset + a].vertex_index;
         if (t[a] < 0 || static_cast<std::size_t>(t[a]) >= num_vertices)
-          throw MeshFileError(path, 0,
-                              internal::Concat("face ", f, " of shape '", shape.name,
-                                               "' refers to vertex ", t[a], " but the file has ",
-                                               num_vertices, " vertices"));
+          throw MeshFileError(
+              path, 0,
+              internal::Concat("face ", f, " of shape '", shape.name, "' refers to vertex ", t[a],
+                               " but the file has ", num_vertices, " vertices"));
       }
       mesh.triangles.push_back(t);
       offset += 3;

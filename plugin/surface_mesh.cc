@@ -41,8 +41,7 @@ void ValidateClosedSurface(const SurfaceMesh& mesh) {
     if (i + 1 < edges.size() && std::get<0>(edges[i + 1]) == a && std::get<1>(edges[i + 1]) == b)
       throw InputError(internal::Concat(
           src, ": edge (", a, ", ", b, ") is used in the same direction by triangles ", t, " and ",
-          std::get<2>(edges[i + 1]),
-          " (non-manifold edge or inconsistently oriented triangles)"));
+          std::get<2>(edges[i + 1]), " (non-manifold edge or inconsistently oriented triangles)"));
     const auto reverse = std::lower_bound(edges.begin(), edges.end(), std::make_tuple(b, a, -1));
     TAUT_DEMAND(reverse != edges.end() && std::get<0>(*reverse) == b && std::get<1>(*reverse) == a,
                 src, ": edge (", a, ", ", b, ") of triangle ", t,
@@ -68,8 +67,8 @@ double CalcSurfaceSignedVolume(const SurfaceMesh& mesh) {
 }
 
 SurfaceMesh MakeBoxSurface(const Vec3& size, int nx, int ny, int nz, const Vec3& min_corner) {
-  TAUT_DEMAND(nx > 0 && ny > 0 && nz > 0, "box surface: cell counts must be > 0, got ", nx, "x",
-              ny, "x", nz);
+  TAUT_DEMAND(nx > 0 && ny > 0 && nz > 0, "box surface: cell counts must be > 0, got ", nx, "x", ny,
+              "x", nz);
   TAUT_DEMAND(size.allFinite() && (size.array() > 0.0).all(),
               "box surface: size must be finite and > 0, got ", size.transpose());
   TAUT_DEMAND(min_corner.allFinite(), "box surface: min corner must be finite");
@@ -114,15 +113,15 @@ SurfaceMesh MakeBoxSurface(const Vec3& size, int nx, int ny, int nz, const Vec3&
 }
 
 SurfaceMesh MakeIcosphereSurface(double radius, int subdivisions, const Vec3& centre) {
-  TAUT_DEMAND(std::isfinite(radius) && radius > 0.0, "icosphere: radius must be finite and > 0, got ",
-              radius);
-  TAUT_DEMAND(subdivisions >= 0 && subdivisions <= 7, "icosphere: subdivisions must be in [0, 7], got ",
-              subdivisions);
+  TAUT_DEMAND(std::isfinite(radius) && radius > 0.0,
+              "icosphere: radius must be finite and > 0, got ", radius);
+  TAUT_DEMAND(subdivisions >= 0 && subdivisions <= 7,
+              "icosphere: subdivisions must be in [0, 7], got ", subdivisions);
   TAUT_DEMAND(centre.allFinite(), "icosphere: centre must be finite");
   const double p = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<Vec3> unit = {{-1, p, 0}, {1, p, 0},  {-1, -p, 0}, {1, -p, 0},
-                            {0, -1, p}, {0, 1, p},  {0, -1, -p}, {0, 1, -p},
-                            {p, 0, -1}, {p, 0, 1},  {-p, 0, -1}, {-p, 0, 1}};
+  std::vector<Vec3> unit = {{-1, p, 0}, {1, p, 0}, {-1, -p, 0}, {1, -p, 0},
+                            {0, -1, p}, {0, 1, p}, {0, -1, -p}, {0, 1, -p},
+                            {p, 0, -1}, {p, 0, 1}, {-p, 0, -1}, {-p, 0, 1}};
   for (Vec3& v : unit) v.normalize();
   std::vector<Triangle> tris = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
                                 {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},

@@ -13,9 +13,9 @@ namespace taut {
 // (b - a) x (c - a)) when the surface is a consistently oriented closed body; vertices that no
 // triangle uses are allowed.
 struct SurfaceMesh {
-  std::vector<Vec3> vertices;        // (num_vertices) positions [m]
-  std::vector<Triangle> triangles;   // (num_triangles x 3) vertex indices
-  std::string source = "surface";    // file name or generator, used in error messages
+  std::vector<Vec3> vertices;       // (num_vertices) positions [m]
+  std::vector<Triangle> triangles;  // (num_triangles x 3) vertex indices
+  std::string source = "surface";   // file name or generator, used in error messages
 };
 
 // Throws InputError naming the source and the triangle or edge when the surface is empty, a vertex
@@ -40,6 +40,7 @@ SurfaceMesh MakeBoxSurface(const Vec3& size, int nx, int ny, int nz,
 // Icosphere: an icosahedron whose triangles are split in four `subdivisions` times, vertices
 // projected onto the sphere of the given radius and centre; outward wound, 20 * 4^subdivisions
 // triangles. subdivisions in [0, 7].
-SurfaceMesh MakeIcosphereSurface(double radius, int subdivisions, const Vec3& centre = Vec3::Zero());
+SurfaceMesh MakeIcosphereSurface(double radius, int subdivisions,
+                                 const Vec3& centre = Vec3::Zero());
 
 }  // namespace taut

@@ -35,8 +35,7 @@ void WriteVtkHexLattice(const std::string& path, const HexLattice& lattice,
     for (int v = 0; v < 8; ++v) {
       const int node = lattice.hexes[c][kVtkHexFromLocal[v]];
       TAUT_DEMAND(node >= 0 && static_cast<std::size_t>(node) < num_points, "VTK file '", path,
-                  "': hex ", c, " refers to node ", node, " but there are ", num_points,
-                  " points");
+                  "': hex ", c, " refers to node ", node, " but there are ", num_points, " points");
       out += ' ' + std::to_string(node);
     }
     out += '\n';

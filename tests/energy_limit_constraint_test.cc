@@ -7,6 +7,7 @@
 
 #include "constraints/sqp_solver.h"
 #include "plugin/box_tet_mesher.h"
+#include "plugin/hex_element_model.h"
 #include "tests/test_utils.h"
 
 namespace taut {
@@ -23,6 +24,19 @@ std::unique_ptr<DeformableBody> MakeCube(double youngs_modulus, int cells, doubl
   auto mesh = std::make_shared<TetMesh>(MakeBoxTetMesh(Vec3(0.1, 0.1, 0.1), cells, cells, cells));
   return std::make_unique<DeformableBody>(
       std::make_unique<TetElementModel>(mesh, settings.material), settings);
+}
+
+// A hex box body named "hex cube" of cells^3 hexes (no world).
+std::unique_ptr<DeformableBody> MakeHexCube(double youngs_modulus, int cells,
+                                            double damping = 2.0) {
+  DeformableBodySettings settings;
+  settings.name = "hex cube";
+  settings.material = {youngs_modulus, 0.3, 1000.0};
+  settings.mass_damping = damping;
+  auto lattice =
+      std::make_shared<HexLattice>(MakeBoxHexLattice(Vec3(0.1, 0.1, 0.1), cells, cells, cells));
+  return std::make_unique<DeformableBody>(
+      std::make_unique<HexElementModel>(lattice, settings.material), settings);
 }
 
 const TetElementModel& Tets(const DeformableBody& body) {
@@ -186,8 +200,9 @@ TEST(EnergyLimitConstraintTest, BadSettingsThrowNamingBodyElementAndRange) {
 // The 0.1 m cube hanging from its top face with a load on its bottom nodes, stepped with the SQP
 // solver (no world). Returns the final height; `max_ratio` gets the largest U_e/U_max after any
 // step (measured with `limit`'s U_max even when the run is unlimited).
-double RunHangingCube(bool limited, double density_limit, double* max_ratio, int* rows) {
-  auto body = MakeCube(2e3, 2);
+double RunHangingCube(bool limited, double density_limit, double* max_ratio, int* rows,
+                      bool hex = false) {
+  auto body = hex ? MakeHexCube(2e3, 2) : MakeCube(2e3, 2);
   body->FixNodesWhere([](const Vec3& X) { return X.z() > 0.1 - 1e-9; });
   std::vector<int> bottom;
   for (int i = 0; i < body->num_nodes(); ++i)
@@ -222,6 +237,71 @@ TEST(EnergyLimitConstraintTest, HangingCubeKeepsEveryElementBelowItsEnergyLimit)
   const double limited_height = RunHangingCube(true, density_limit, &limited_ratio, &limited_rows);
   std::printf(
       "hanging cube: unlimited height %.4f m, max U/Umax %.2f; limited height %.4f m, "
+      "max U/Umax %.5f, max rows %d\n",
+      free_height, free_ratio, limited_height, limited_ratio, limited_rows);
+  EXPECT_GT(free_ratio, 10.0);
+  EXPECT_LE(limited_ratio, 1.0 + 1e-2);
+  EXPECT_GT(limited_rows, 0);
+  EXPECT_GT(free_height - 0.1, 3.0 * (limited_height - 0.1));
+  EXPECT_GT(limited_height, 0.1);
+}
+
+const HexElementModel& Hexes(const DeformableBody& body) {
+  return dynamic_cast<const HexElementModel&>(body.model());
+}
+
+TEST(EnergyLimitConstraintTest, HexBodyRowsHaveEightNodesAndTheFrozenRotationJacobian) {
+  auto body = MakeHexCube(2e3, 2);
+  const HexElementModel& hexes = Hexes(*body);
+  const VecX x = Stretched(*body, 0.1);
+  const double u_max = 1e-9;
+  EnergyLimitConstraint source(*body, EnergyLimitSettings::PerElementEnergy(u_max), 2);
+  std::vector<ConstraintRow> rows;
+  ASSERT_EQ(source.AppendRows(x, 1, rows), 8);
+  double worst = 0.0;
+  for (const ConstraintRow& row : rows) {
+    const int e = static_cast<int>(row.key & 0xffffffffffffULL);
+    EXPECT_EQ(row.key >> 48, 2u);
+    EXPECT_EQ(row.body, 1);
+    EXPECT_EQ(row.type, RowType::kEnergyLimit);
+    ASSERT_EQ(row.num_nodes, 8);
+    for (int n = 0; n < 8; ++n) EXPECT_EQ(row.nodes[n], hexes.element_nodes(e)[n]);
+    const HexRestElement& rest = hexes.rest(e);
+    const HexNodes xe = hexes.GatherElement(x, e);
+    const double energy = CalcHexElementEnergy(rest, xe, HexRotationMethod::kCenterPolar);
+    EXPECT_NEAR(row.C, 1.0 - energy / u_max, 1e-9 * energy / u_max);
+    // FD of C over the body's positions with the element rotation frozen at x (MATH.md §4).
+    const Mat3 R = CalcHexRotation(rest, xe, HexRotationMethod::kCenterPolar);
+    VecX J = VecX::Zero(x.size());
+    for (int n = 0; n < 8; ++n) J.segment<3>(3 * row.nodes[n]) = row.J[n];
+    const MatX fd = testing::CentralDifference(
+        [&](const VecX& y) {
+          const double U = CalcCorotatedHexEnergy(rest, hexes.GatherElement(y, e), R);
+          return VecX::Constant(1, 1.0 - U / u_max);
+        },
+        x, 1e-7);
+    ASSERT_GT(fd.norm(), 1.0);
+    worst = std::max(worst, testing::RelativeError(J.transpose(), fd));
+  }
+  EXPECT_LT(worst, 1e-6);
+  double min_C = kInf;
+  for (const ConstraintRow& row : rows) min_C = std::min(min_C, row.C);
+  EXPECT_NEAR(source.CalcMaxEnergyRatio(x), 1.0 - min_C, 1e-9 * (1.0 - min_C));
+  // Energy densities are multiplied by the hex rest volume (5 cm cubes).
+  EnergyLimitConstraint density(*body, EnergyLimitSettings::EnergyDensity(3.0), 0);
+  for (double limit : density.element_limits()) EXPECT_NEAR(limit, 3.0 * std::pow(0.05, 3), 1e-15);
+}
+
+TEST(EnergyLimitConstraintTest, HangingHexCubeKeepsEveryElementBelowItsEnergyLimit) {
+  const double density_limit = 20.0;  // J/m^3
+  double free_ratio = 0.0, limited_ratio = 0.0;
+  int free_rows = 0, limited_rows = 0;
+  const double free_height =
+      RunHangingCube(false, density_limit, &free_ratio, &free_rows, /*hex=*/true);
+  const double limited_height =
+      RunHangingCube(true, density_limit, &limited_ratio, &limited_rows, /*hex=*/true);
+  std::printf(
+      "hanging hex cube: unlimited height %.4f m, max U/Umax %.2f; limited height %.4f m, "
       "max U/Umax %.5f, max rows %d\n",
       free_height, free_ratio, limited_height, limited_ratio, limited_rows);
   EXPECT_GT(free_ratio, 10.0);

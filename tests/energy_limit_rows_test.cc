@@ -141,5 +141,127 @@ TEST(EnergyLimitRowsTest, GenericJacobianIsForceOverLimit) {
   EXPECT_EQ(CalcEnergyLimitValue(5.0, std::numeric_limits<double>::infinity()), 1.0);
 }
 
+// A random, non-parallelepiped rest hex of edge ~0.2 m (corners of a box moved by up to 15 %).
+HexNodes RandomRestHex(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-0.03, 0.03);
+  HexNodes X;
+  for (int a = 0; a < 8; ++a) X[a] = 0.1 * HexCornerSign(a) + Vec3(u(rng), u(rng), u(rng));
+  return X;
+}
+
+VecX FlattenHex(const HexNodes& x) {
+  VecX v(24);
+  for (int n = 0; n < 8; ++n) v.segment<3>(3 * n) = x[n];
+  return v;
+}
+
+HexNodes UnflattenHex(const VecX& v) {
+  HexNodes x;
+  for (int n = 0; n < 8; ++n) x[n] = v.segment<3>(3 * n);
+  return x;
+}
+
+// x = Q (A X) + t with A = I + amplitude * noise, plus nodal noise of `amplitude` / 4 [m].
+HexNodes DeformHex(const HexNodes& X, double amplitude, std::mt19937& rng) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  Mat3 A = Mat3::Identity();
+  for (int i = 0; i < 9; ++i) A.data()[i] += amplitude * n(rng);
+  const Mat3 Q = RandomRotation(rng);
+  const Vec3 t(n(rng), n(rng), n(rng));
+  HexNodes x;
+  for (int a = 0; a < 8; ++a)
+    x[a] = Q * (A * X[a] + 0.025 * amplitude * Vec3(n(rng), n(rng), n(rng))) + 0.1 * t;
+  return x;
+}
+
+TEST(EnergyLimitRowsTest, HexJacobianMatchesCentralDifferencesWithFrozenRotation) {
+  std::mt19937 rng(5);
+  const LameParameters lame = TestLame();
+  double worst = 0.0;
+  for (int trial = 0; trial < 100; ++trial) {
+    const HexRestElement rest = CalcHexRestElement(RandomRestHex(rng), lame);
+    const HexNodes x = DeformHex(rest.X, trial % 2 == 0 ? 0.05 : 0.3, rng);
+    const auto method =
+        trial % 3 == 0 ? HexRotationMethod::kInscribedTet : HexRotationMethod::kCenterPolar;
+    const Mat3 R = CalcHexRotation(rest, x, method);
+    const double u_max = 1e-3;
+    const HexEnergyLimitRow row = CalcHexEnergyLimitRow(rest, x, R, u_max);
+    EXPECT_NEAR(row.energy, CalcHexElementEnergy(rest, x, method), 1e-15);
+    EXPECT_DOUBLE_EQ(row.C, 1.0 - row.energy / u_max);
+    // C(x) = 1 - U(x, R)/U_max with R held fixed.
+    const MatX fd = CentralDifference(
+        [&](const VecX& v) {
+          return VecX::Constant(1, CalcHexEnergyLimitRow(rest, UnflattenHex(v), R, u_max).C);
+        },
+        FlattenHex(x), 1e-7);
+    ASSERT_GT(fd.norm(), 1e-1) << "trial " << trial;
+    ASSERT_GT(row.J.norm(), 1e-1) << "trial " << trial;
+    const double error = RelativeError(row.J.transpose(), fd);
+    worst = std::max(worst, error);
+    EXPECT_LT(error, 1e-6) << "trial " << trial;
+  }
+  std::printf("hex energy-limit Jacobian (R frozen) vs FD: worst relative error %.2e\n", worst);
+}
+
+TEST(EnergyLimitRowsTest, HexJacobianApproximatesFullGradientAtSmallStrain) {
+  // MATH.md §4: neglecting dR/dx costs about 2a relative error at nodal strain noise a.
+  std::mt19937 rng(9);
+  const LameParameters lame = TestLame();
+  for (int trial = 0; trial < 20; ++trial) {
+    const HexRestElement rest = CalcHexRestElement(RandomRestHex(rng), lame);
+    const HexNodes x = DeformHex(rest.X, 1e-3, rng);
+    const double u_max = 1e-6;
+    const HexEnergyLimitRow row = CalcHexEnergyLimitRow(
+        rest, x, CalcHexRotation(rest, x, HexRotationMethod::kCenterPolar), u_max);
+    // C(x) with R = R(x) recomputed at every evaluation.
+    const MatX fd = CentralDifference(
+        [&](const VecX& v) {
+          return VecX::Constant(1, 1.0 - CalcHexElementEnergy(rest, UnflattenHex(v),
+                                                              HexRotationMethod::kCenterPolar) /
+                                             u_max);
+        },
+        FlattenHex(x), 1e-8);
+    ASSERT_GT(fd.norm(), 1e-3);
+    EXPECT_LT(RelativeError(row.J.transpose(), fd), 2e-2) << "trial " << trial;
+  }
+}
+
+TEST(EnergyLimitRowsTest, HexRestAndRigidMotionGiveOneAndZeroJacobian) {
+  std::mt19937 rng(4);
+  const HexRestElement rest = CalcHexRestElement(RandomRestHex(rng), TestLame());
+  const HexEnergyLimitRow at_rest = CalcHexEnergyLimitRow(rest, rest.X, Mat3::Identity(), 1e-5);
+  EXPECT_EQ(at_rest.C, 1.0);
+  EXPECT_LT(at_rest.J.norm(), 1e-6);
+  const Mat3 Q = RandomRotation(rng);
+  HexNodes x;
+  for (int n = 0; n < 8; ++n) x[n] = Q * rest.X[n] + Vec3(0.3, -0.2, 1.0);
+  for (auto method : {HexRotationMethod::kCenterPolar, HexRotationMethod::kInscribedTet}) {
+    const HexEnergyLimitRow rigid =
+        CalcHexEnergyLimitRow(rest, x, CalcHexRotation(rest, x, method), 1e-5);
+    EXPECT_NEAR(rigid.C, 1.0, 1e-9);
+    EXPECT_LT(rigid.J.norm(), 1e-3);
+  }
+}
+
+TEST(EnergyLimitRowsTest, HexUniaxialStretchEnergyAndLimitValue) {
+  // Box hex 0.2 m, G = diag(1 + e, 1, 1): U = V (mu + lambda/2) e^2 (uniform strain, exact).
+  const LameParameters lame = TestLame();
+  HexNodes X;
+  for (int a = 0; a < 8; ++a) X[a] = 0.1 * HexCornerSign(a);
+  const HexRestElement rest = CalcHexRestElement(X, lame);
+  const double e = 0.02;
+  HexNodes x = X;
+  for (Vec3& p : x) p.x() *= 1.0 + e;
+  const double U = 0.008 * (lame.mu + 0.5 * lame.lambda) * e * e;
+  const double u = CalcHexElementEnergy(rest, x, HexRotationMethod::kCenterPolar);
+  EXPECT_NEAR(u, U, 1e-12 * U);
+  const HexEnergyLimitRow row = CalcHexEnergyLimitRow(rest, x, Mat3::Identity(), 2.0 * U);
+  EXPECT_NEAR(row.C, 0.5, 1e-12);
+  // dC/de = -(dU/de)/U_max = -2 U/(e U_max) = -1/e along dx_n = (X_n.x, 0, 0).
+  VecX dx = VecX::Zero(24);
+  for (int n = 0; n < 8; ++n) dx[3 * n] = X[n].x();
+  EXPECT_NEAR(row.J.dot(dx), -1.0 / e, 1e-9 / e);
+}
+
 }  // namespace
 }  // namespace taut

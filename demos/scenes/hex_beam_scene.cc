@@ -1,5 +1,7 @@
 #include "demos/scenes/hex_beam_scene.h"
 
+#include <algorithm>
+
 #include "plugin/hex_shapes.h"
 
 namespace taut {
@@ -32,10 +34,11 @@ HexBeamScene::HexBeamScene(const std::vector<Beam>& beams, double cell_size) {
     lattice->source = beams[b].name;
     DeformableBody* body = world().AddHexBody(lattice, beams[b].settings);
     body->FixNodesWhere([](const Vec3& X) { return X.x() < 1e-9; });
-    limits_.push_back(beams[b].u_max ? world().SetEnergyLimits(
-                                           body, EnergyLimitSettings::PerElementEnergy(
-                                                     *beams[b].u_max))
-                                     : nullptr);
+    EnergyLimitConstraint* limits = nullptr;
+    if (beams[b].u_max)
+      limits =
+          world().SetEnergyLimits(body, EnergyLimitSettings::PerElementEnergy(*beams[b].u_max));
+    limits_.push_back(limits);
     std::vector<int> tip;
     for (int i = 0; i < body->num_nodes(); ++i)
       if (lattice->nodes[i].x() > kLength - 1e-9) tip.push_back(i);
@@ -43,6 +46,7 @@ HexBeamScene::HexBeamScene(const std::vector<Beam>& beams, double cell_size) {
   }
   max_ratio_.assign(beams.size(), 0.0);
   max_energy_.assign(beams.size(), 0.0);
+  max_tip_.assign(beams.size(), 0.0);
 }
 
 Vec3 HexBeamScene::CalcTipDisplacement(int b) const {
@@ -73,6 +77,7 @@ void HexBeamScene::Step(double dt) {
   for (size_t b = 0; b < limits_.size(); ++b) {
     max_ratio_[b] = std::max(max_ratio_[b], CalcMaxEnergyRatio(static_cast<int>(b)));
     max_energy_[b] = std::max(max_energy_[b], CalcMaxElementEnergy(static_cast<int>(b)));
+    max_tip_[b] = std::max(max_tip_[b], CalcTipDisplacement(static_cast<int>(b)).norm());
   }
 }
 
@@ -100,6 +105,7 @@ void HexBeamScene::WriteFigures(nlohmann::json& figures) const {
     entry["youngs_modulus_pa"] = body.settings().material.youngs_modulus;
     entry["tip_displacement_m"] = tip.norm();
     entry["tip_displacement_z_m"] = tip.z();
+    entry["max_tip_displacement_m"] = max_tip_[b];
     entry["num_hexes"] = body.model().num_elements();
     entry["max_element_energy_j"] = max_energy_[b];
     if (limits_[b] != nullptr) {
