@@ -9,7 +9,7 @@ namespace taut {
 
 // Settings of the refinement.
 struct ActiveSetPolishSettings {
-  int max_rounds = 8;          // direct solves at most
+  int max_rounds = 8;          // Newton steps at most
   int sweeps_per_round = 5;    // PGS sweeps after each Newton step (fix the free set)
   double tolerance = 1e-6;     // stop when the natural-map residual is below it
   double regularization = 1e-8;   // relative to max W_cc, added to the active block's diagonal
