@@ -47,7 +47,8 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   // Limits the principal stretches of every tet of `body` (paper A). Replaces earlier strain
   // limits of that body. Throws InputError for invalid settings or a body that is not a tet body.
   StrainLimitConstraint* SetStrainLimits(DeformableBody* body, const StrainLimitSettings& limits);
-  // Limits the elastic energy of every tet of `body` to U_max (paper B: C = 1 - U_e/U_max).
+  // Limits the elastic energy of every element (tet or hex) of `body` to U_max (paper B:
+  // C = 1 - U_e/U_max).
   // Replaces earlier energy limits of the body; throws InputError for invalid settings.
   EnergyLimitConstraint* SetEnergyLimits(DeformableBody* body, const EnergyLimitSettings& limits);
   // Removes every constraint source (limits) of the body.
