@@ -66,6 +66,37 @@ double CalcSurfaceSignedVolume(const SurfaceMesh& mesh) {
   return six_volume / 6.0;
 }
 
+SurfaceMesh MakeCylinderSurface(double length, double radius, int segments, int rings,
+                                const Vec3& axis_start) {
+  TAUT_DEMAND(length > 0 && radius > 0 && std::isfinite(length) && std::isfinite(radius),
+              "cylinder surface: length and radius must be finite and > 0");
+  TAUT_DEMAND(segments >= 3 && rings >= 1, "cylinder surface: need >= 3 segments and >= 1 ring");
+  SurfaceMesh mesh;
+  mesh.source = "cylinder surface";
+  // Ring r, segment k -> vertex r * segments + k; then the two cap centres.
+  for (int r = 0; r <= rings; ++r)
+    for (int k = 0; k < segments; ++k) {
+      const double phi = 2.0 * M_PI * k / segments;
+      mesh.vertices.push_back(axis_start + Vec3(length * r / rings, radius * std::cos(phi),
+                                                radius * std::sin(phi)));
+    }
+  const int start_cap = static_cast<int>(mesh.vertices.size());
+  mesh.vertices.push_back(axis_start);
+  mesh.vertices.push_back(axis_start + Vec3(length, 0, 0));
+  auto id = [segments](int r, int k) { return r * segments + (k % segments); };
+  for (int r = 0; r < rings; ++r)
+    for (int k = 0; k < segments; ++k) {
+      // Outward: (x along, then around) gives normal pointing away from the axis.
+      mesh.triangles.push_back({id(r, k), id(r, k + 1), id(r + 1, k + 1)});
+      mesh.triangles.push_back({id(r, k), id(r + 1, k + 1), id(r + 1, k)});
+    }
+  for (int k = 0; k < segments; ++k) {
+    mesh.triangles.push_back({start_cap, id(0, k + 1), id(0, k)});
+    mesh.triangles.push_back({start_cap + 1, id(rings, k), id(rings, k + 1)});
+  }
+  return mesh;
+}
+
 SurfaceMesh MakeBoxSurface(const Vec3& size, int nx, int ny, int nz, const Vec3& min_corner) {
   TAUT_DEMAND(nx > 0 && ny > 0 && nz > 0, "box surface: cell counts must be > 0, got ", nx, "x", ny,
               "x", nz);

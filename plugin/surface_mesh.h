@@ -40,6 +40,11 @@ SurfaceMesh MakeBoxSurface(const Vec3& size, int nx, int ny, int nz,
 // Icosphere: an icosahedron whose triangles are split in four `subdivisions` times, vertices
 // projected onto the sphere of the given radius and centre; outward wound, 20 * 4^subdivisions
 // triangles. subdivisions in [0, 7].
+// Closed cylinder surface along +x from axis_start, `segments` around, `rings` along, capped by
+// triangle fans around a centre vertex; outward wound.
+SurfaceMesh MakeCylinderSurface(double length, double radius, int segments, int rings,
+                                const Vec3& axis_start = Vec3::Zero());
+
 SurfaceMesh MakeIcosphereSurface(double radius, int subdivisions,
                                  const Vec3& centre = Vec3::Zero());
 

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 namespace taut {
 namespace {
 
@@ -37,6 +39,39 @@ TEST(HexBeamSceneTest, EnergyLimitsOrderTheSagAndHoldEveryStep) {
   EXPECT_GT(tip[1], tip[2]);
   EXPECT_GT(tip[2], tip[3] + 0.1);
   EXPECT_GT(tip[3], tip[4]);
+}
+
+}  // namespace
+}  // namespace taut
+
+namespace taut {
+namespace {
+
+// The round visible surface rides on the square voxel lattice: exact at rest, follows the tip,
+// and is written per frame as VTK and OBJ.
+TEST(HexBeamSceneTest, EmbeddedCylinderSurfaceFollowsTheLatticeAndIsWritten) {
+  HexBeamScene scene(HexBeamScene::DefaultBeams());
+  ASSERT_EQ(scene.num_embedded_surfaces(), 5);
+  const SurfaceMesh rest = MakeCylinderSurface(1.0, 0.06, 24, 14, Vec3(0.0, 0.0, 0.0));
+  const std::vector<Vec3> at_rest = scene.CalcEmbeddedSurfacePositions(0);
+  ASSERT_EQ(at_rest.size(), rest.vertices.size());
+  for (size_t i = 0; i < at_rest.size(); ++i)
+    EXPECT_LT((at_rest[i] - rest.vertices[i]).norm(), 1e-12) << "vertex " << i;
+  for (int step = 0; step < 60; ++step) scene.Step(1.0 / 240.0);
+  // The tip cap centre (last vertex) moves with the tip of the lattice.
+  const Vec3 cap = scene.CalcEmbeddedSurfacePositions(0).back() - rest.vertices.back();
+  const Vec3 tip = scene.CalcTipDisplacement(0);
+  EXPECT_GT(tip.norm(), 0.05);
+  EXPECT_LT((cap - tip).norm(), 0.1 * tip.norm());
+  const std::string dir = ::testing::TempDir();
+  scene.WriteVtkFrame(dir, 7);
+  for (const char* ext : {".vtk", ".obj"}) {
+    const std::string path = dir + "/" + scene.world().deformable_body(0).name() +
+                             "_surface_000007" + ext;
+    std::FILE* file = std::fopen(path.c_str(), "r");
+    EXPECT_NE(file, nullptr) << path;
+    if (file != nullptr) std::fclose(file);
+  }
 }
 
 }  // namespace

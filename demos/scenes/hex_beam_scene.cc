@@ -43,6 +43,10 @@ HexBeamScene::HexBeamScene(const std::vector<Beam>& beams, double cell_size) {
     for (int i = 0; i < body->num_nodes(); ++i)
       if (lattice->nodes[i].x() > kLength - 1e-9) tip.push_back(i);
     tip_nodes_.push_back(tip);
+    // The visible round beam (12 cm diameter), embedded in the voxel lattice.
+    AttachEmbeddedSurface(static_cast<int>(b),
+                          MakeCylinderSurface(kLength, kRadius, 24, 14,
+                                              Vec3(0.0, 0.5 * static_cast<double>(b), 0.0)));
   }
   max_ratio_.assign(beams.size(), 0.0);
   max_energy_.assign(beams.size(), 0.0);

@@ -27,6 +27,35 @@ void Scene::WriteVtkFrame(const std::string& dir, int frame) const {
       WriteVtkHexLattice(dir + "/" + body.name() + name, hexes->lattice(), &positions);
     }
   }
+  for (int i = 0; i < num_embedded_surfaces(); ++i) {
+    const std::vector<Vec3> positions = CalcEmbeddedSurfacePositions(i);
+    char name[64];
+    std::snprintf(name, sizeof(name), "_surface_%06d", frame);
+    const std::string base = dir + "/" + world().deformable_body(embedded_[i].body).name() + name;
+    WriteVtkSurface(base + ".vtk", positions, embedded_[i].surface.triangles);
+    WriteEmbeddedSurfaceObj(base + ".obj", positions, embedded_[i].surface.triangles);
+  }
+}
+
+namespace {
+// The hex model of body b; throws InputError when it is not a hex body.
+const HexElementModel& HexModelOf(const DeformableWorld& world, int b) {
+  const auto* hexes = dynamic_cast<const HexElementModel*>(&world.deformable_body(b).model());
+  TAUT_DEMAND(hexes != nullptr, "body '", world.deformable_body(b).name(),
+              "': surfaces can only be embedded in hex bodies");
+  return *hexes;
+}
+}  // namespace
+
+int Scene::AttachEmbeddedSurface(int body, const SurfaceMesh& surface) {
+  embedded_.push_back({body, EmbedSurface(HexModelOf(world(), body).lattice(), surface)});
+  return static_cast<int>(embedded_.size()) - 1;
+}
+
+std::vector<Vec3> Scene::CalcEmbeddedSurfacePositions(int i) const {
+  const EmbeddedSurfaceOutput& out = embedded_[i];
+  return CalcEmbeddedPositions(out.surface, HexModelOf(world(), out.body).lattice(),
+                               world().deformable_body(out.body).x());
 }
 
 namespace {

@@ -9,6 +9,8 @@
 #include <vector>
 
 #include "demos/scenes/bullet_world_holder.h"
+#include "plugin/embedded_surface.h"
+#include "plugin/surface_mesh.h"
 
 namespace taut {
 
@@ -27,6 +29,13 @@ class Scene {
   // Writes VTK files of every deformable body for frame `frame` into dir.
   virtual void WriteVtkFrame(const std::string& dir, int frame) const;
 
+  // Embeds `surface` in the lattice of hex body `body` (trilinear weights per vertex) so that
+  // WriteVtkFrame also writes the deformed surface (VTK and OBJ) each frame. Returns its index.
+  int AttachEmbeddedSurface(int body, const SurfaceMesh& surface);
+  int num_embedded_surfaces() const { return static_cast<int>(embedded_.size()); }
+  // Deformed vertex positions of embedded surface i at the bodies' current positions.
+  std::vector<Vec3> CalcEmbeddedSurfacePositions(int i) const;
+
   DeformableWorld& world() { return holder_.world; }
   const DeformableWorld& world() const { return holder_.world; }
   // FNV-1a hash of every deformable x, v and every rigid transform and velocity (bitwise).
@@ -34,6 +43,12 @@ class Scene {
 
  protected:
   BulletWorldHolder holder_;
+  // A surface embedded in a hex body.
+  struct EmbeddedSurfaceOutput {
+    int body;
+    EmbeddedSurface surface;
+  };
+  std::vector<EmbeddedSurfaceOutput> embedded_;
 };
 
 // Command-line options of a scene run.
