@@ -89,8 +89,7 @@ double SqpSolver::CalcMerit(double h, const std::vector<DeformableBody*>& bodies
                             const std::vector<ConstraintSource*>& sources,
                             const std::vector<VecX>& v, double rho) {
   for (size_t b = 0; b < bodies.size(); ++b) dv_[b] = v[b] - bodies[b]->v_star();
-  VecX scratch;
-  return 0.5 * EnergyNormSquared(bodies, dv_, scratch) +
+  return 0.5 * EnergyNormSquared(bodies, dv_, scratch_) +
          rho * CalcViolationSum(h, bodies, sources, v) / h;
 }
 
@@ -126,7 +125,6 @@ void SqpSolver::Solve(double h, const std::vector<DeformableBody*>& bodies,
   }
   double rho = 0.0, last_alpha = 1.0;
   bool restoring = false;
-  VecX scratch;
   for (int k = 0;; ++k) {
     auto t_rows = std::chrono::steady_clock::now();
     const double violation = CollectRows(h, bodies, sources);
@@ -146,15 +144,16 @@ void SqpSolver::Solve(double h, const std::vector<DeformableBody*>& bodies,
     double residual = 0.0, force = 0.0;
     for (size_t b = 0; b < nb; ++b) {
       dv_[b] = v_k_[b] - bodies[b]->v_star();
-      bodies[b]->ApplySystemMatrix(dv_[b], scratch);
-      VecX jt = VecX::Zero(scratch.size());
+      bodies[b]->ApplySystemMatrix(dv_[b], scratch_);
+      VecX& jt = jt_;
+      jt.setZero(scratch_.size());
       for (int c : body_rows_[b])
         for (int n = 0; n < rows_[c].num_nodes; ++n)
           jt.segment<3>(3 * rows_[c].nodes[n]) += lambda_[c] * rows_[c].J[n];
       // Constrained DOFs carry reaction forces: compare on free DOFs only (A v is 0 there).
       for (int i = 0; i < bodies[b]->num_nodes(); ++i)
         if (bodies[b]->node_kind(i) != NodeKind::kFree) jt.segment<3>(3 * i).setZero();
-      residual += (scratch - jt).squaredNorm();
+      residual += (scratch_ - jt).squaredNorm();
       force += jt.squaredNorm();
     }
     const double stationarity = force > 0.0 ? std::sqrt(residual / force) : std::sqrt(residual);
@@ -229,7 +228,7 @@ void SqpSolver::Solve(double h, const std::vector<DeformableBody*>& bodies,
     rho = std::max(rho, 2.0 * lambda_qp_.maxCoeff());
     const double phi_k = CalcMerit(h, bodies, sources, v_k_, rho);
     for (size_t b = 0; b < nb; ++b) dv_[b] = v_qp_[b] - v_k_[b];
-    const double step_norm = EnergyNormSquared(bodies, dv_, scratch);
+    const double step_norm = EnergyNormSquared(bodies, dv_, scratch_);
     double alpha = 1.0;
     for (int halving = 0; halving < settings.max_line_search_halvings; ++halving) {
       for (size_t b = 0; b < nb; ++b) v_trial_[b] = v_k_[b] + alpha * (v_qp_[b] - v_k_[b]);

@@ -73,6 +73,7 @@ class SqpSolver {
   MatX W_;
   VecX q_, lambda_, lambda_qp_;
   std::vector<VecX> v_k_, v_qp_, v_trial_, dv_;
+  VecX scratch_, jt_;  // 3N work vectors (A dv, J^T lambda), reused across steps
   std::vector<std::pair<std::uint64_t, double>> previous_;  // last step's multipliers by key
   std::vector<std::pair<std::uint64_t, double>> iterate_;   // this step's lambda_k by key
 };
