@@ -218,8 +218,7 @@ PointContact CalcPointShapeDistance(const Vec3& point, const btCollisionShape& s
   none.gap = std::numeric_limits<double>::infinity();
   const int type = shape.getShapeType();
   // Planes have an infinite AABB; everything else gets the cheap AABB early out.
-  if (type != STATIC_PLANE_PROXYTYPE &&
-      CalcAabbDistance(point, shape, transform) > max_distance) {
+  if (type != STATIC_PLANE_PROXYTYPE && CalcAabbDistance(point, shape, transform) > max_distance) {
     return none;
   }
   const Vec3 p = ToEigen(transform.invXform(ToBullet(point)));
@@ -235,9 +234,9 @@ PointContact CalcPointShapeDistance(const Vec3& point, const btCollisionShape& s
     }
     case CAPSULE_SHAPE_PROXYTYPE: {
       const auto& capsule = static_cast<const btCapsuleShape&>(shape);
-      result = ToWorld(CalcRoundedSegment(p, capsule.getUpAxis(), capsule.getHalfHeight(),
-                                          capsule.getRadius()),
-                       transform);
+      result = ToWorld(
+          CalcRoundedSegment(p, capsule.getUpAxis(), capsule.getHalfHeight(), capsule.getRadius()),
+          transform);
       break;
     }
     case BOX_SHAPE_PROXYTYPE: {
@@ -272,8 +271,8 @@ PointContact CalcPointShapeDistance(const Vec3& point, const btCollisionShape& s
         // Triangles overlapping the box p ± max_distance (local frame).
         ClosestTriangleCallback callback(p);
         const btVector3 r(max_distance, max_distance, max_distance);
-        static_cast<const btConcaveShape&>(shape).processAllTriangles(
-            &callback, ToBullet(p) - r, ToBullet(p) + r);
+        static_cast<const btConcaveShape&>(shape).processAllTriangles(&callback, ToBullet(p) - r,
+                                                                      ToBullet(p) + r);
         LocalContact local;
         result = callback.Result(&local) ? ToWorld(local, transform) : none;
       } else {

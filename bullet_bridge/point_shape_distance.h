@@ -13,7 +13,13 @@
 //  - concave triangle shapes (btBvhTriangleMeshShape, heightfields): the triangles themselves, no
 //    margin. The sign comes from the winding of the nearest triangle (outward = (v1-v0)x(v2-v0)),
 //    so for an open mesh it is a one-sided distance: every point behind a triangle counts as
-//    penetrating (depth up to max_distance).
+//    penetrating, and points deeper than max_distance behind it are not found (valid = false).
+//    Ties at shared edges/vertices go to the triangle most aligned with p − q (not the
+//    angle-weighted pseudo-normal), so the sign can be wrong near saddle vertices.
+// Why analytic where possible: with margin 0 GJK/EPA matches the analytic sphere, capsule and box
+// to ~1e-15 outside and inside (tests/point_shape_distance_test.cc), but costs ~0.9 us per call
+// against 20-45 ns, and with Bullet's default box margin it measures to a box with rounded edges
+// (up to (√3 − 1)·margin away from the user box at corners).
 #pragma once
 
 #include <BulletCollision/CollisionShapes/btCollisionShape.h>
@@ -26,10 +32,10 @@ namespace taut {
 
 // Result of a point-vs-shape query.
 struct PointContact {
-  double gap = 0.0;        // signed distance, < 0 = penetration [m]
-  Vec3 normal{0, 0, 0};    // unit, from the rigid shape towards the point (outward when inside)
+  double gap = 0.0;      // signed distance, < 0 = penetration [m]
+  Vec3 normal{0, 0, 0};  // unit, from the rigid shape towards the point (outward when inside)
   Vec3 point_on_shape{0, 0, 0};  // closest point on the shape surface, world
-  bool valid = false;      // false: the point is farther than max_distance (other fields unset)
+  bool valid = false;  // false: the point is farther than max_distance (other fields unset)
 };
 
 // Signed distance from `point` (world) to `shape` placed at `transform`. Returns valid = false

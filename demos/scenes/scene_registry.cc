@@ -14,7 +14,7 @@ const std::vector<SceneInfo>& SceneRegistry() {
        [] { return std::make_unique<TetBeamScene>(TetBeamScene::DefaultBeams()); }},
       {"vertical_beam",
        "paper A Fig. 4 column (10 kPa) collapsing, x limited to 5 %, in all four projection modes",
-       480, 1.0 / 240.0,
+       120, 1.0 / 240.0,
        [] { return std::make_unique<VerticalBeamScene>(VerticalBeamScene::AllModes()); }},
       {"hex_beam",
        "paper B Fig. 3 cylindrical 56-hex beams: 150 kPa linear, U_e <= 1.0 / 0.5 / 0.1 J, "
