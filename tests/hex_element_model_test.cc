@@ -251,6 +251,23 @@ TEST(HexElementModelTest, StaticCantileverMatchesTimoshenkoWithin5Percent) {
   EXPECT_LT(tip_coarse, 0.9 * tip);  // coarse elements (l/H = 1) lock visibly
 }
 
+TEST(HexElementModelTest, RefinedHexAndTetCantileversAgreeWithEachOtherAndBeamTheory) {
+  // Refined meshes of the same L/H = 5, nu = 0 beam: hexes 40 x 2 x 4, tets 80 x 2 x 16 cubes.
+  const double L = 1.0, H = 0.2, E = 1e8, nu = 0.0, rho = 1000;
+  const Material material{E, nu, rho};
+  const double A = H * H, I = H * H * H * H / 12.0, q = rho * 9.81 * A;
+  const double G = E / (2 * (1 + nu)), kappa = 10 * (1 + nu) / (12 + 11 * nu);
+  const double timoshenko = q * std::pow(L, 4) / (8 * E * I) + q * L * L / (2 * kappa * G * A);
+  auto hex = MakeBeam(L, H, 40, 4, material, true);
+  auto tet = MakeBeam(L, H, 80, 16, material, false);
+  const double tip_hex = StaticTip(*hex, L), tip_tet = StaticTip(*tet, L);
+  std::printf("refined cantilevers: hex %.4e m, tet %.4e m, Timoshenko %.4e m\n", tip_hex,
+              tip_tet, timoshenko);
+  EXPECT_NEAR(tip_hex / tip_tet, 1.0, 0.05);
+  EXPECT_NEAR(tip_hex / timoshenko, 1.0, 0.05);
+  EXPECT_NEAR(tip_tet / timoshenko, 1.0, 0.05);
+}
+
 TEST(HexElementModelTest, HexBeamLocksLessThanTetBeamAtNearIncompressibility) {
   // Same grid (same nodes), nu = 0.45: the 6-tet split locks volumetrically, hexes much less.
   const double L = 1.0, H = 0.2;
