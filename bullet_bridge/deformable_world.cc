@@ -126,25 +126,47 @@ void DeformableWorld::internalSingleStepSimulation(btScalar h) {
   stats_.ms_total = MsSince(start);
 }
 
+void DeformableWorld::CollectStaticObjects(std::vector<const btCollisionObject*>& objects) const {
+  objects.clear();
+  const btCollisionObjectArray& all = getCollisionObjectArray();
+  for (int i = 0; i < all.size(); ++i) {
+    const btCollisionObject* object = all[i];
+    if (object->getCollisionShape()->getShapeType() == kDeformableShapeType) continue;
+    if (object->isStaticOrKinematicObject()) objects.push_back(object);
+  }
+}
+
 void DeformableWorld::StepDeformableBodies(double h) {
   const Vec3 gravity = ToEigen(getGravity());
   auto t = std::chrono::steady_clock::now();
   for (auto& entry : bodies_) entry->body().BeginStep(h, gravity);
   stats_.ms_unconstrained = MsSince(t);
-  // Limits: one SQP per constrained body (limit rows couple no bodies).
+  // Limits and contacts with static/kinematic rigid objects: one SQP per constrained body (these
+  // rows couple no bodies).
+  std::vector<const btCollisionObject*> objects;
+  CollectStaticObjects(objects);
   std::vector<DeformableBody*> island(1);
   std::vector<ConstraintSource*> sources;
   for (auto& entry : bodies_) {
-    if (entry->sources.empty()) continue;
-    island[0] = &entry->body();
+    DeformableBody& body = entry->body();
+    if (!objects.empty() && entry->contacts == nullptr)
+      entry->contacts = std::make_unique<RigidContactSource>(
+          body, next_source_id_++, body.settings().friction, body.settings().contact_margin);
+    if (entry->sources.empty() && objects.empty()) continue;
+    island[0] = &body;
     sources.clear();
     for (auto& source : entry->sources) sources.push_back(source.get());
+    if (!objects.empty()) {
+      entry->contacts->set_objects(objects);
+      sources.push_back(entry->contacts.get());
+    }
     StepStats body_stats;
     entry->solver.Solve(h, island, sources, solver_settings_, body_stats);
     stats_.ms_rows += body_stats.ms_rows;
     stats_.ms_solve += body_stats.ms_solve;
     stats_.rows_strain += body_stats.rows_strain;
     stats_.rows_energy += body_stats.rows_energy;
+    stats_.rows_contact += body_stats.rows_contact;
     stats_.pgs_sweeps += body_stats.pgs_sweeps;
     stats_.sqp_iterations = std::max(stats_.sqp_iterations, body_stats.sqp_iterations);
     stats_.restoration_iterations += body_stats.restoration_iterations;

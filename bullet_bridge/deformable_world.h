@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "bullet_bridge/deformable_collision_object.h"
+#include "bullet_bridge/rigid_contact_source.h"
 #include "constraints/energy_limit_constraint.h"
 #include "constraints/sqp_solver.h"
 #include "constraints/step_stats.h"
@@ -68,13 +69,16 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   void internalSingleStepSimulation(btScalar h) override;
 
  private:
-  // Unconstrained implicit step of every deformable body, then integration.
+  // Unconstrained implicit step of every deformable body, limits and contacts, integration.
   void StepDeformableBodies(double h);
+  // Static and kinematic rigid objects (contact partners of deformables), into objects.
+  void CollectStaticObjects(std::vector<const btCollisionObject*>& objects) const;
 
   // A body with its Bullet proxy, its constraint sources and its solver (warm starts).
   struct Entry {
     std::unique_ptr<DeformableCollisionObject> object;
     std::vector<std::unique_ptr<ConstraintSource>> sources;
+    std::unique_ptr<RigidContactSource> contacts;  // made when the world has static objects
     SqpSolver solver;
     DeformableBody& body() { return object->body(); }
     btCollisionObject& collision_object() { return object->collision_object(); }

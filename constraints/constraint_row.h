@@ -23,6 +23,11 @@ struct ConstraintRow {
   int body = -1;          // index of the deformable body in the island
   int num_nodes = 0;
   RowType type = RowType::kStrainLimit;
+  // Friction rows (contact tangents): 1 or 2 = how many rows back the contact's normal row is;
+  // 0 for unilateral rows. A friction row targets J v = 0 within the Coulomb disk of radius
+  // mu lambda_n; its C is unused.
+  int friction_of = 0;
+  double mu = 0.0;  // Coulomb coefficient of a friction row
   std::array<int, kMaxRowNodes> nodes{};  // node indices in the body
   std::array<Vec3, kMaxRowNodes> J{};     // dC/dx_node
 };

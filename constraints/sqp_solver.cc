@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 namespace taut {
 
@@ -93,6 +94,28 @@ double SqpSolver::CalcMerit(double h, const std::vector<DeformableBody*>& bodies
          rho * CalcViolationSum(h, bodies, sources, v) / h;
 }
 
+double SqpSolver::CalcRowVelocity(const ConstraintRow& row, const std::vector<VecX>& v) const {
+  double jv = 0.0;
+  for (int n = 0; n < row.num_nodes; ++n) jv += row.J[n].dot(v[row.body].segment<3>(3 * row.nodes[n]));
+  return jv;
+}
+
+void SqpSolver::BuildPgsRows() {
+  // Unilateral rows, and friction pairs on the Coulomb disk of their contact's normal row.
+  pgs_rows_.assign(rows_.size(), MakeUnilateralRow());
+  for (size_t c = 0; c < rows_.size(); ++c) {
+    const ConstraintRow& row = rows_[c];
+    if (row.friction_of == 0) continue;
+    PgsRow& p = pgs_rows_[c];
+    p.kind = RowKind::kFriction;
+    p.cone = FrictionCone::kDisk;
+    p.normal = static_cast<int>(c) - row.friction_of;
+    p.partner = row.friction_of == 1 ? static_cast<int>(c) + 1 : static_cast<int>(c) - 1;
+    p.lo = -std::numeric_limits<double>::infinity();
+    p.mu = row.mu;
+  }
+}
+
 void SqpSolver::WarmStart(const std::vector<std::pair<std::uint64_t, double>>& from) {
   lambda_.setZero(static_cast<int>(rows_.size()));
   for (size_t c = 0; c < rows_.size(); ++c) {
@@ -135,6 +158,8 @@ void SqpSolver::Solve(double h, const std::vector<DeformableBody*>& bodies,
         rows_.begin(), rows_.end(), [](const auto& r) { return r.type == RowType::kStrainLimit; }));
     stats.rows_energy = static_cast<int>(std::count_if(
         rows_.begin(), rows_.end(), [](const auto& r) { return r.type == RowType::kEnergyLimit; }));
+    stats.rows_contact = static_cast<int>(std::count_if(
+        rows_.begin(), rows_.end(), [](const auto& r) { return r.type == RowType::kContact; }));
     WarmStart(iterate_);
     if (rows_.empty()) {
       lambda_.resize(0);
@@ -187,8 +212,10 @@ void SqpSolver::Solve(double h, const std::vector<DeformableBody*>& bodies,
         jdv += row.J[n].dot(bodies[row.body]->v_star().segment<3>(3 * row.nodes[n]) -
                             v_k_[row.body].segment<3>(3 * row.nodes[n]));
       q_[c] = restoring ? row.C / h : row.C / h + jdv;
+      // Friction rows: w_t = J_t v = J_t (v* + Y lambda), so q = J_t v* (restoration: 0).
+      if (row.friction_of > 0) q_[c] = restoring ? 0.0 : jdv + CalcRowVelocity(row, v_k_);
     }
-    pgs_rows_.assign(m, MakeUnilateralRow());
+    BuildPgsRows();
     if (restoring) {
       lambda_qp_.setZero(m);
     } else {

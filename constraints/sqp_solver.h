@@ -61,6 +61,10 @@ class SqpSolver {
   double CalcMerit(double h, const std::vector<DeformableBody*>& bodies,
                    const std::vector<ConstraintSource*>& sources, const std::vector<VecX>& v,
                    double rho);
+  // J v of a row for per-body velocities v.
+  double CalcRowVelocity(const ConstraintRow& row, const std::vector<VecX>& v) const;
+  // PGS row descriptions of rows_ (unilateral, or friction on the disk of its normal row).
+  void BuildPgsRows();
   // Warm-start multipliers of the current rows from `previous_` (matched by key).
   void WarmStart(const std::vector<std::pair<std::uint64_t, double>>& from);
   // Stores the current rows' multipliers into `to`, sorted by key.

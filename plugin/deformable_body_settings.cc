@@ -13,6 +13,10 @@ void DeformableBodySettings::Validate() const {
   TAUT_DEMAND(std::isfinite(stiffness_damping) && stiffness_damping >= 0.0, "body '", name,
               "': stiffness damping (Rayleigh beta) must be finite and >= 0 s, got ",
               stiffness_damping);
+  TAUT_DEMAND(std::isfinite(friction) && friction >= 0.0, "body '", name,
+              "': friction must be finite and >= 0, got ", friction);
+  TAUT_DEMAND(std::isfinite(contact_margin) && contact_margin > 0.0, "body '", name,
+              "': contact margin must be finite and > 0 m, got ", contact_margin);
 }
 
 }  // namespace taut

@@ -1,0 +1,85 @@
+// Deformable bodies against Bullet's static shapes: normal rows keep nodes out of the ground,
+// friction rows on the Coulomb disk decide stick and slip.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "demos/scenes/bullet_world_holder.h"
+#include "plugin/box_tet_mesher.h"
+
+namespace taut {
+namespace {
+
+// A soft 0.2 m cube above a static ground plane z = 0 (plane friction 1).
+struct CubeOnGround {
+  BulletWorldHolder holder;
+  btStaticPlaneShape plane{btVector3(0, 0, 1), 0};
+  std::unique_ptr<btRigidBody> ground;
+  DeformableBody* cube = nullptr;
+
+  CubeOnGround(double friction, double height, const btVector3& gravity) {
+    btRigidBody::btRigidBodyConstructionInfo info(0.0, nullptr, &plane);
+    ground = std::make_unique<btRigidBody>(info);
+    ground->setFriction(1.0);
+    holder.world.addRigidBody(ground.get());
+    holder.world.setGravity(gravity);
+    DeformableBodySettings settings;
+    settings.name = "cube";
+    settings.material = {5e4, 0.3, 500.0};
+    settings.mass_damping = 0.5;
+    settings.friction = friction;
+    cube = holder.world.AddTetBody(
+        MakeBoxTetMesh(Vec3(0.2, 0.2, 0.2), 2, 2, 2, Vec3(-0.1, -0.1, height)), settings);
+  }
+  ~CubeOnGround() { holder.world.removeRigidBody(ground.get()); }
+  void Run(int steps) {
+    for (int i = 0; i < steps; ++i) holder.world.stepSimulation(1.0 / 240.0, 1, 1.0 / 240.0);
+  }
+  double MinZ() const {
+    double z = 1e9;
+    for (int i = 0; i < cube->num_nodes(); ++i) z = std::min(z, cube->node_position(i).z());
+    return z;
+  }
+  double MeanX() const {
+    double x = 0.0;
+    for (int i = 0; i < cube->num_nodes(); ++i) x += cube->node_position(i).x();
+    return x / cube->num_nodes();
+  }
+};
+
+TEST(RigidContactTest, DroppedCubeComesToRestOnTheGroundWithoutSinkingIn) {
+  CubeOnGround scene(0.5, 0.1, btVector3(0, 0, -9.81));
+  double deepest = 0.0;
+  for (int i = 0; i < 240; ++i) {
+    scene.Run(1);
+    deepest = std::min(deepest, scene.MinZ());
+  }
+  std::printf("dropped cube: deepest node %.2e m, rest height %.4f m, contact rows %d\n", deepest,
+              scene.MinZ(), scene.holder.world.last_step_stats().rows_contact);
+  EXPECT_GT(deepest, -2e-3);  // penetration below 2 mm even at the 1.4 m/s impact
+  EXPECT_LT(scene.MinZ(), 0.01);  // it did land
+  EXPECT_GT(scene.holder.world.last_step_stats().rows_contact, 0);
+  EXPECT_LT(scene.cube->v().norm() / std::sqrt(scene.cube->num_nodes()), 0.05);  // at rest
+}
+
+TEST(RigidContactTest, FrictionSticksBelowTheConeAndSlidesAboveIt) {
+  // Gravity tilted by 30 degrees = a 30 degree incline: tan 30 = 0.577.
+  const double theta = M_PI / 6.0;
+  const btVector3 gravity(9.81 * std::sin(theta), 0, -9.81 * std::cos(theta));
+  CubeOnGround sticky(1.0, 0.0005, gravity), slippery(0.1, 0.0005, gravity);
+  const double x0 = sticky.MeanX();
+  sticky.Run(120);
+  slippery.Run(120);
+  const double stick = sticky.MeanX() - x0, slide = slippery.MeanX() - x0;
+  // Sliding block: a = g (sin - mu cos) = 4.06 m/s^2 -> 0.51 m in 0.5 s.
+  const double expected = 0.5 * 9.81 * (std::sin(theta) - 0.1 * std::cos(theta)) * 0.25;
+  std::printf("incline 30 deg, 0.5 s: mu = 1 moves %.4f m, mu = 0.1 moves %.4f m (rigid block "
+              "%.4f m)\n",
+              stick, slide, expected);
+  EXPECT_LT(stick, 0.02);
+  EXPECT_NEAR(slide, expected, 0.25 * expected);
+  EXPECT_GT(slippery.MinZ(), -2e-3);
+}
+
+}  // namespace
+}  // namespace taut
