@@ -1,3 +1,4 @@
+#include "demos/scenes/falling_sphere_scene.h"
 #include "demos/scenes/hex_beam_scene.h"
 #include "demos/scenes/scene.h"
 #include "demos/scenes/tet_beam_scene.h"
@@ -16,6 +17,11 @@ const std::vector<SceneInfo>& SceneRegistry() {
        "paper A Fig. 4 column (10 kPa) collapsing, x limited to 5 %, in all four projection modes",
        120, 1.0 / 240.0,
        [] { return std::make_unique<VerticalBeamScene>(VerticalBeamScene::AllModes()); }},
+      {"falling_sphere",
+       "paper B Fig. 4: 32-hex spheres (R = 1 m) dropped 2 m onto the ground: 150 kPa, 1 MPa, "
+       "150 kPa with U_e <= 500 J",
+       480, 1.0 / 240.0,
+       [] { return std::make_unique<FallingSphereScene>(FallingSphereScene::DefaultSpheres()); }},
       {"hex_beam",
        "paper B Fig. 3 cylindrical 56-hex beams: 150 kPa linear, U_e <= 1.0 / 0.5 / 0.1 J, "
        "2 MPa linear",
