@@ -39,3 +39,27 @@ TEST(ArmadilloVoxelizationTest, TwoMetreArmadilloGivesAboutThePapers365Hexes) {
 
 }  // namespace
 }  // namespace taut
+
+#include "demos/scenes/armadillo_scene.h"
+
+namespace taut {
+namespace {
+
+// Paper B Fig. 6 setting: the energy-limited armadillo lands (0.5 m drop) without sinking into
+// the ground and its limit holds.
+TEST(ArmadilloSceneTest, LimitedArmadilloLandsAndItsEnergyLimitHolds) {
+  if (!std::filesystem::exists(std::string(TAUT_DATA_DIR) + "/armadillo.off"))
+    GTEST_SKIP() << "data/armadillo.off missing: run scripts/fetch_armadillo.sh";
+  ArmadilloScene scene({{"limited", 500e3, 100.0}},
+                       std::string(TAUT_DATA_DIR) + "/armadillo.off");
+  for (int step = 0; step < 120; ++step) scene.Step(1.0 / 240.0);
+  std::printf("armadillo: deepest %.2e m, flattening %.3f, U/Umax %.5f, contact rows %d\n",
+              scene.deepest(0), scene.max_flattening(0), scene.max_energy_ratio(0),
+              scene.world().last_step_stats().rows_contact);
+  EXPECT_GT(scene.deepest(0), -1e-3);
+  EXPECT_GT(scene.world().last_step_stats().rows_contact, 0);  // it is on the ground
+  EXPECT_LE(scene.max_energy_ratio(0), 1.01);
+}
+
+}  // namespace
+}  // namespace taut
