@@ -55,6 +55,7 @@ double PolishActiveSet(const MatX& W, const VecX& q, const std::vector<PgsRow>& 
     if (settings.sweeps_per_round > 0) {
       PgsSettings fix = pgs;
       fix.max_sweeps = settings.sweeps_per_round;
+      fix.validate_input = false;  // same problem as the PGS call that came before
       const PgsStats stats = SolvePgs(W, q, rows, candidate, fix);
       if (sweeps != nullptr) *sweeps += stats.sweeps;
       f = objective(candidate);

@@ -26,15 +26,18 @@ struct Sweep {
   Eigen::Ref<VecX>& lambda;
   double omega;
   double threshold;  // rows with W_cc <= threshold are skipped
+  VecX* w = nullptr;  // optional w = W lambda + q kept current: O(m) per changed row, O(1) else
   double delta = 0.0;
 
   // Whether row c is skipped for a too small diagonal.
   bool IsSkipped(int c) const { return !(W(c, c) > threshold); }
   // w_c = q_c + (W lambda)_c, column c by symmetry.
-  double CalcW(int c) const { return q[c] + W.col(c).dot(lambda); }
+  double CalcW(int c) const { return w != nullptr ? (*w)[c] : q[c] + W.col(c).dot(lambda); }
   // Stores lambda_c and records W_cc |Delta lambda_c|.
   void Set(int c, double value) {
-    delta = std::max(delta, W(c, c) * std::abs(value - lambda[c]));
+    const double change = value - lambda[c];
+    delta = std::max(delta, W(c, c) * std::abs(change));
+    if (w != nullptr && change != 0.0) w->noalias() += W.col(c) * change;
     lambda[c] = value;
   }
   // Scalar update of row c on [lo, hi].
@@ -75,7 +78,7 @@ double CalcSkippedValue(const PgsRow& row) {
 PgsStats SolvePgs(const MatX& W, const VecX& q, const std::vector<PgsRow>& rows,
                   Eigen::Ref<VecX> lambda, const PgsSettings& settings) {
   ValidatePgsSettings(settings);
-  ValidateLcpProblem(W, q, rows, lambda);
+  if (settings.validate_input) ValidateLcpProblem(W, q, rows, lambda);
   PgsStats stats;
   const int m = static_cast<int>(rows.size());
   if (m == 0) {
@@ -89,6 +92,14 @@ PgsStats SolvePgs(const MatX& W, const VecX& q, const std::vector<PgsRow>& rows,
     if (!sweep.IsSkipped(c)) continue;
     ++stats.skipped_rows;
     lambda[c] = CalcSkippedValue(rows[c]);
+  }
+  if (settings.w_workspace != nullptr) {
+    // Incremental w: one product now, then a column update per changed multiplier.
+    VecX& w = *settings.w_workspace;
+    w.resize(m);
+    w.noalias() = W * lambda;
+    w += q;
+    sweep.w = &w;
   }
   bool residual_current = false;
   for (int s = 0; s < settings.max_sweeps; ++s) {

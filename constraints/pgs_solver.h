@@ -31,6 +31,9 @@ struct PgsSettings {
   double relaxation = 1.0;          // SOR factor omega in (0, 2); 1 = plain Gauss-Seidel
   double min_diagonal = 1e-10;  // rows with W_cc <= min_diagonal * max_d W_dd are skipped (their
                                 // lambda is set to the point of their set nearest 0); in [0, 1)
+  bool validate_input = true;   // check W, q, rows, lambda (O(m^2)); off for trusted callers
+  VecX* w_workspace = nullptr;  // when set, w = W lambda + q is kept current in it: a sweep then
+                                // costs O(m) per changed row instead of O(m) per row
 };
 
 // What a SolvePgs call did.

@@ -59,15 +59,13 @@ void SqpSolver::BuildDelassus(const std::vector<DeformableBody*>& bodies) {
       for (int n = 0; n < row.num_nodes; ++n) Y.col(k).segment<3>(3 * row.nodes[n]) += row.J[n];
     }
     bodies[b]->SolveSystemColumns(Y);
-    // W_cd = J_c . Y_d (J sparse over a row's nodes).
+    // W_c. = J_c Y (J sparse over a row's nodes): a 1x3 times 3xm product per node.
     for (size_t i = 0; i < rows.size(); ++i) {
       const ConstraintRow& row = rows_[rows[i]];
-      for (size_t k = 0; k < rows.size(); ++k) {
-        double w = 0.0;
-        for (int n = 0; n < row.num_nodes; ++n)
-          w += row.J[n].dot(Y.col(k).segment<3>(3 * row.nodes[n]));
-        W_(rows[i], rows[k]) = w;
-      }
+      w_row_.setZero(static_cast<int>(rows.size()));
+      for (int n = 0; n < row.num_nodes; ++n)
+        w_row_.noalias() += row.J[n].transpose() * Y.middleRows<3>(3 * row.nodes[n]);
+      for (size_t k = 0; k < rows.size(); ++k) W_(rows[i], rows[k]) = w_row_[k];
     }
   }
   // Symmetrize (W is J A^-1 J^T; round-off makes it slightly asymmetric).
@@ -221,7 +219,10 @@ void SqpSolver::Solve(double h, const std::vector<DeformableBody*>& bodies,
     } else {
       lambda_qp_ = lambda_;
     }
-    const PgsStats pgs = SolvePgs(W_, q_, pgs_rows_, lambda_qp_, settings.pgs);
+    PgsSettings pgs_settings = settings.pgs;
+    pgs_settings.validate_input = false;  // rows built here: W symmetric by construction
+    pgs_settings.w_workspace = &w_;
+    const PgsStats pgs = SolvePgs(W_, q_, pgs_rows_, lambda_qp_, pgs_settings);
     stats.pgs_sweeps += pgs.sweeps;
     if (settings.polish_active_set && pgs.residual > settings.polish.tolerance) {
       stats.active_set_solves++;

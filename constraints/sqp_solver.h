@@ -75,7 +75,8 @@ class SqpSolver {
   std::vector<std::vector<int>> body_rows_;  // (num_bodies) rows of each body
   std::vector<MatX> Y_;                      // (num_bodies) 3N x rows of the body
   MatX W_;
-  VecX q_, lambda_, lambda_qp_;
+  VecX q_, lambda_, lambda_qp_, w_;
+  Eigen::RowVectorXd w_row_;  // one row of W being assembled
   std::vector<VecX> v_k_, v_qp_, v_trial_, dv_;
   VecX scratch_, jt_;  // 3N work vectors (A dv, J^T lambda), reused across steps
   std::vector<std::pair<std::uint64_t, double>> previous_;  // last step's multipliers by key
