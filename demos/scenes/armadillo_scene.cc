@@ -48,9 +48,7 @@ ArmadilloScene::ArmadilloScene(const std::vector<Material>& materials, const std
     const Vec3 u = (v - bounds.min()) * scale;
     v = Vec3(u.x(), -u.z(), u.y() + kDrop);
   }
-  btRigidBody::btRigidBodyConstructionInfo info(0.0, nullptr, &plane_);
-  ground_ = std::make_unique<btRigidBody>(info);
-  holder_.world.addRigidBody(ground_.get());
+  holder_.AddStaticGround();
   for (size_t m = 0; m < materials.size(); ++m) {
     SurfaceMesh placed = scan;
     for (Vec3& v : placed.vertices) v.x() += 2.0 * static_cast<double>(m);
@@ -75,7 +73,6 @@ ArmadilloScene::ArmadilloScene(const std::vector<Material>& materials, const std
   max_ratio_.assign(materials.size(), 0.0);
 }
 
-ArmadilloScene::~ArmadilloScene() { holder_.world.removeRigidBody(ground_.get()); }
 
 void ArmadilloScene::Step(double dt) {
   Scene::Step(dt);

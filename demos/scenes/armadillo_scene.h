@@ -21,7 +21,6 @@ class ArmadilloScene : public Scene {
   // `off_path` defaults to <source>/data/armadillo.off; throws InputError naming the fetch script
   // when the file is missing.
   explicit ArmadilloScene(const std::vector<Material>& materials, const std::string& off_path = "");
-  ~ArmadilloScene() override;
   static std::vector<Material> DefaultMaterials();
 
   void Step(double dt) override;
@@ -31,8 +30,6 @@ class ArmadilloScene : public Scene {
   double max_energy_ratio(int b) const { return max_ratio_[b]; }
 
  private:
-  btStaticPlaneShape plane_{btVector3(0, 0, 1), 0};
-  std::unique_ptr<btRigidBody> ground_;
   std::vector<EnergyLimitConstraint*> limits_;
   std::vector<double> rest_height_, max_flattening_, deepest_, max_ratio_;
 };

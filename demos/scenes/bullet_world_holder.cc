@@ -4,6 +4,15 @@ namespace taut {
 
 BulletWorldHolder::BulletWorldHolder() { world.setGravity(btVector3(0, 0, -9.81)); }
 
+btRigidBody* BulletWorldHolder::AddStaticGround(double friction) {
+  shapes.push_back(std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), 0));
+  btRigidBody::btRigidBodyConstructionInfo info(0.0, nullptr, shapes.back().get());
+  rigid_bodies.push_back(std::make_unique<btRigidBody>(info));
+  rigid_bodies.back()->setFriction(friction);
+  world.addRigidBody(rigid_bodies.back().get());
+  return rigid_bodies.back().get();
+}
+
 BulletWorldHolder::~BulletWorldHolder() {
   for (auto& body : rigid_bodies) world.removeRigidBody(body.get());
 }

@@ -13,6 +13,8 @@ namespace taut {
 struct BulletWorldHolder {
   BulletWorldHolder();
   ~BulletWorldHolder();
+  // Adds a static ground plane z = 0 with the given Coulomb friction; the holder owns it.
+  btRigidBody* AddStaticGround(double friction = 1.0);
   btDefaultCollisionConfiguration configuration;
   btCollisionDispatcher dispatcher{&configuration};
   btDbvtBroadphase broadphase;

@@ -18,9 +18,7 @@ std::vector<FallingSphereScene::Sphere> FallingSphereScene::DefaultSpheres() {
 }
 
 FallingSphereScene::FallingSphereScene(const std::vector<Sphere>& spheres, double cell_size) {
-  btRigidBody::btRigidBodyConstructionInfo info(0.0, nullptr, &plane_);
-  ground_ = std::make_unique<btRigidBody>(info);
-  holder_.world.addRigidBody(ground_.get());
+  holder_.AddStaticGround();
   for (size_t s = 0; s < spheres.size(); ++s) {
     const Vec3 centre(3.0 * static_cast<double>(s), 0.0, kDropHeight + kRadius);
     auto lattice = std::make_shared<HexLattice>(MakeSphereHexLattice(kRadius, cell_size, centre));
@@ -42,7 +40,6 @@ FallingSphereScene::FallingSphereScene(const std::vector<Sphere>& spheres, doubl
   max_ratio_.assign(spheres.size(), 0.0);
 }
 
-FallingSphereScene::~FallingSphereScene() { holder_.world.removeRigidBody(ground_.get()); }
 
 double FallingSphereScene::CalcBottom(int s) const {
   const DeformableBody& body = world().deformable_body(s);

@@ -20,7 +20,6 @@ class FallingSphereScene : public Scene {
   };
   // Cell 0.5 m: 4 x 4 x 4 grid, 32 hexes kept (paper: about 27).
   explicit FallingSphereScene(const std::vector<Sphere>& spheres, double cell_size = 0.5);
-  ~FallingSphereScene() override;
   static std::vector<Sphere> DefaultSpheres();
 
   void Step(double dt) override;
@@ -37,8 +36,6 @@ class FallingSphereScene : public Scene {
   double max_energy_ratio(int s) const { return max_ratio_[s]; }
 
  private:
-  std::unique_ptr<btRigidBody> ground_;
-  btStaticPlaneShape plane_{btVector3(0, 0, 1), 0};
   std::vector<EnergyLimitConstraint*> limits_;
   std::vector<bool> landed_;
   std::vector<double> max_flattening_, bounce_, deepest_, max_ratio_;

@@ -54,11 +54,7 @@ HexBeamScene::HexBeamScene(const std::vector<Beam>& beams, double cell_size) {
 }
 
 Vec3 HexBeamScene::CalcTipDisplacement(int b) const {
-  const DeformableBody& body = world().deformable_body(b);
-  Vec3 sum = Vec3::Zero();
-  for (int i : tip_nodes_[b])
-    sum += body.node_position(i) - body.model().rest_positions().segment<3>(3 * i);
-  return sum / static_cast<double>(tip_nodes_[b].size());
+  return CalcMeanDisplacement(world().deformable_body(b), tip_nodes_[b]);
 }
 
 double HexBeamScene::CalcMaxElementEnergy(int b) const {

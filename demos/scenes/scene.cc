@@ -94,6 +94,12 @@ uint64_t Scene::CalcStateHash() const {
   return hash;
 }
 
+Vec3 CalcMeanDisplacement(const DeformableBody& body, const std::vector<int>& nodes) {
+  Vec3 sum = Vec3::Zero();
+  for (int i : nodes) sum += body.node_position(i) - body.model().rest_positions().segment<3>(3 * i);
+  return sum / static_cast<double>(nodes.size());
+}
+
 const SceneInfo& FindScene(const std::string& name) {
   std::string known;
   for (const SceneInfo& info : SceneRegistry()) {

@@ -51,6 +51,9 @@ class Scene {
   std::vector<EmbeddedSurfaceOutput> embedded_;
 };
 
+// Mean displacement x - X of the listed nodes of a body [m].
+Vec3 CalcMeanDisplacement(const DeformableBody& body, const std::vector<int>& nodes);
+
 // Command-line options of a scene run.
 struct SceneOptions {
   int steps = 0;    // 0: the scene's default

@@ -46,11 +46,7 @@ TetBeamScene::TetBeamScene(const std::vector<Beam>& beams, int cells_x, int cell
 }
 
 Vec3 TetBeamScene::CalcTipDisplacement(int b) const {
-  const DeformableBody& body = world().deformable_body(b);
-  Vec3 sum = Vec3::Zero();
-  for (int i : tip_nodes_[b])
-    sum += body.node_position(i) - body.model().rest_positions().segment<3>(3 * i);
-  return sum / static_cast<double>(tip_nodes_[b].size());
+  return CalcMeanDisplacement(world().deformable_body(b), tip_nodes_[b]);
 }
 
 double TetBeamScene::CalcLength(int b) const {
