@@ -225,19 +225,19 @@ int AppendStrainLimitRows(int element, const TetRestRows& r, const SignedSvd& sv
 
 int AppendStrainLimitRows(int element, const TetRestRows& r, const TetPositions& x, const Mat3& Q,
                           const StrainLimitParams& params, std::vector<StrainLimitRow>* rows) {
-  const SignedSvd svd = CalcSignedSvd(CalcTetDeformationGradient(x, r));
+  const SignedSvd svd = CalcSignedSvd(CalcTetDeformationGradient(r, x));
   return AppendStrainLimitRows(element, r, svd, Q, params, rows);
 }
 
 double CalcStrainLimitViolation(const TetRestRows& r, const TetPositions& x, const Mat3& Q,
                                 const StrainLimitParams& params) {
-  const SignedSvd svd = CalcSignedSvd(CalcTetDeformationGradient(x, r));
+  const SignedSvd svd = CalcSignedSvd(CalcTetDeformationGradient(r, x));
   RowEvaluator evaluator(-1, r, svd, Q, params, nullptr);
   return std::max(0.0, -evaluator.Run());
 }
 
 double CalcMaterialAxisStrain(const TetRestRows& r, const TetPositions& x, const Vec3& q) {
-  return (CalcTetDeformationGradient(x, r) * q).norm() - 1.0;
+  return (CalcTetDeformationGradient(r, x) * q).norm() - 1.0;
 }
 
 }  // namespace taut

@@ -5,12 +5,6 @@
 
 namespace taut {
 
-Mat3 CalcTetDeformationGradient(const TetPositions& x, const TetRestRows& r) {
-  Mat3 G = Mat3::Zero();
-  for (int n = 0; n < 4; ++n) G += x[n] * r[n].transpose();
-  return G;
-}
-
 double CalcClampedGapDenominator(const Vec3& s, int i, int m, double epsilon) {
   TAUT_ASSERT(i != m);
   // Clamp the canonically ordered pair (a < b), then flip the sign for (b, a) (R1).

@@ -10,6 +10,7 @@
 
 #include "plugin/common.h"
 #include "plugin/signed_svd.h"
+#include "plugin/tet_rest_data.h"
 
 namespace taut {
 
@@ -29,9 +30,6 @@ struct SvdDifferential {
   Vec3 ds;  // ds_i = (U^T dG V)_ii
   Mat3 dV;  // V Omega^V
 };
-
-// Deformation gradient G = sum_n x_n r_n^T (paper A eq. 3; MATH.md §0).
-Mat3 CalcTetDeformationGradient(const TetPositions& x, const TetRestRows& r);
 
 // Denominator of the pair (i, m), D_im = s_i^2 - s_m^2, clamped as in MATH.md §2 R1: when
 // |D| < epsilon it becomes sgn(D) epsilon with sgn(0) := +1, applied to the pair ordered

@@ -22,9 +22,9 @@ TetRestData CalcTetRestData(const TetMesh& mesh) {
   return rest;
 }
 
-Mat3 CalcTetDeformationGradient(const TetRestElement& rest, const std::array<Vec3, 4>& x) {
-  Mat3 G = x[0] * rest.r[0].transpose();
-  for (int n = 1; n < 4; ++n) G.noalias() += x[n] * rest.r[n].transpose();
+Mat3 CalcTetDeformationGradient(const std::array<Vec3, 4>& r, const std::array<Vec3, 4>& x) {
+  Mat3 G = x[0] * r[0].transpose();
+  for (int n = 1; n < 4; ++n) G.noalias() += x[n] * r[n].transpose();
   return G;
 }
 

@@ -23,7 +23,12 @@ struct TetRestData {
 // Validates the mesh (ValidateTetMesh) and computes r_n and rest volumes of every tet.
 TetRestData CalcTetRestData(const TetMesh& mesh);
 
-// Deformation gradient G = sum_n x_n r_n^T of one tet at node positions x.
-Mat3 CalcTetDeformationGradient(const TetRestElement& rest, const std::array<Vec3, 4>& x);
+// Deformation gradient G = sum_n x_n r_n^T of one tet from its rows r_n and node positions x
+// (paper A eq. 3; MATH.md §0).
+Mat3 CalcTetDeformationGradient(const std::array<Vec3, 4>& r, const std::array<Vec3, 4>& x);
+// The same from the element's rest data.
+inline Mat3 CalcTetDeformationGradient(const TetRestElement& rest, const std::array<Vec3, 4>& x) {
+  return CalcTetDeformationGradient(rest.r, x);
+}
 
 }  // namespace taut

@@ -150,7 +150,7 @@ TEST(StrainLimitRowsTest, JacobianMatchesFdOnRandomStatesForEveryMode) {
       const TetPositions x = PositionsFromG(RandomG(&rng), X, Vec3(0.1, 0.2, 0.3));
       const Mat3 Q = RandomRotation(&rng);
       StrainLimitParams params = RandomParams(&rng, mode, trial);
-      const SignedSvd svd = CalcSignedSvd(CalcTetDeformationGradient(x, r));
+      const SignedSvd svd = CalcSignedSvd(CalcTetDeformationGradient(r, x));
       const double h = std::min(1e-6, 1e-3 * MinGap(svd.s));
       const Mat3 V_prime = Q.transpose() * svd.V;
       std::vector<StrainLimitRow> rows = AllRows(r, x, Q, params);
@@ -239,7 +239,7 @@ TEST(StrainLimitRowsTest, GapClampChangesOnlyRowsWithSmallGaps) {
     const std::vector<StrainLimitRow> exact = AllRows(r, x, Q, params);
     params.svd_gap_epsilon = 1e-2;
     const std::vector<StrainLimitRow> clamped = AllRows(r, x, Q, params);
-    const Vec3 s = CalcSignedSvd(CalcTetDeformationGradient(x, r)).s;
+    const Vec3 s = CalcSignedSvd(CalcTetDeformationGradient(r, x)).s;
     ASSERT_EQ(exact.size(), clamped.size());
     for (size_t k = 0; k < exact.size(); ++k) {
       EXPECT_EQ(exact[k].C, clamped[k].C);
@@ -480,7 +480,7 @@ TEST(StrainLimitRowsTest, EmitsOnlyActiveSideBelowMargin) {
       const TetRestRows r = MakeRestRows(&rng, &X);
       const TetPositions x = PositionsFromG(RandomG(&rng), X, Vec3::Zero());
       const Mat3 Q = RandomRotation(&rng);
-      const Vec3 s = CalcSignedSvd(CalcTetDeformationGradient(x, r)).s;
+      const Vec3 s = CalcSignedSvd(CalcTetDeformationGradient(r, x)).s;
       const std::vector<StrainLimitRow> all = AllRows(r, x, Q, params);
       const bool per_axis =
           mode == StrainProjection::kHyperbolic || mode == StrainProjection::kOrthogonal;

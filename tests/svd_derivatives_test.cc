@@ -49,7 +49,7 @@ SignedSvd PerturbedSvd(const TetPositions& x, const TetRestRows& r, int c, doubl
                        const SignedSvd& ref) {
   TetPositions xp = x;
   xp[c / 3][c % 3] += h;
-  SignedSvd svd = CalcSignedSvd(CalcTetDeformationGradient(xp, r));
+  SignedSvd svd = CalcSignedSvd(CalcTetDeformationGradient(r, xp));
   for (int i = 0; i < 3; ++i) {
     if (svd.V.col(i).dot(ref.V.col(i)) < 0) {
       svd.V.col(i) *= -1.0;
@@ -62,7 +62,7 @@ SignedSvd PerturbedSvd(const TetPositions& x, const TetRestRows& r, int c, doubl
 // Central FD of s_i and of column v_i with step h.
 void CalcFdSvd(const TetPositions& x, const TetRestRows& r, int i, double h, Vec12* ds,
                Mat3x12* dv) {
-  const SignedSvd ref = CalcSignedSvd(CalcTetDeformationGradient(x, r));
+  const SignedSvd ref = CalcSignedSvd(CalcTetDeformationGradient(r, x));
   for (int c = 0; c < 12; ++c) {
     const SignedSvd p = PerturbedSvd(x, r, c, h, ref);
     const SignedSvd m = PerturbedSvd(x, r, c, -h, ref);
@@ -102,7 +102,7 @@ TEST(SvdDerivativesTest, SingularValueGradientMatchesFdOnRandomAndInvertedStates
     const TetRestRows r = RandomRestRows(&rng, &X);
     const Mat3 G = RandomG(&rng, inverted);
     const TetPositions x = PositionsFromG(G, X, Vec3(0.3, -0.2, 0.1));
-    const SignedSvd svd = CalcSignedSvd(CalcTetDeformationGradient(x, r));
+    const SignedSvd svd = CalcSignedSvd(CalcTetDeformationGradient(r, x));
     ASSERT_EQ(svd.s[2] < 0, inverted);
     if (MinGap(svd.s) < 0.05) continue;
     for (int i = 0; i < 3; ++i) {
@@ -126,7 +126,7 @@ TEST(SvdDerivativesTest, SingularVectorGradientMatchesFdOnRandomAndInvertedState
     std::array<Vec3, 4> X;
     const TetRestRows r = RandomRestRows(&rng, &X);
     const TetPositions x = PositionsFromG(RandomG(&rng, trial % 2 == 1), X, Vec3::Zero());
-    const SignedSvd svd = CalcSignedSvd(CalcTetDeformationGradient(x, r));
+    const SignedSvd svd = CalcSignedSvd(CalcTetDeformationGradient(r, x));
     if (MinGap(svd.s) < 0.05) continue;
     for (int i = 0; i < 3; ++i) {
       Vec12 ds_fd;
@@ -152,7 +152,7 @@ TEST(SvdDerivativesTest, SingularVectorGradientExactNearRepeatedValuesWithSmallS
       const Vec3 s = inverted_pair ? Vec3(1.5, 0.5, -0.5 + delta) : Vec3(1.2, 1.2 - delta, 0.8);
       const Mat3 G = RandomRotation(&rng) * s.asDiagonal() * RandomRotation(&rng).transpose();
       const TetPositions x = PositionsFromG(G, X, Vec3::Zero());
-      const SignedSvd svd = CalcSignedSvd(CalcTetDeformationGradient(x, r));
+      const SignedSvd svd = CalcSignedSvd(CalcTetDeformationGradient(r, x));
       double max_err = 0.0, max_norm = 0.0;
       for (int i = 0; i < 3; ++i) {
         Vec12 ds_fd;
@@ -182,7 +182,7 @@ TEST(SvdDerivativesTest, GapClampActsOnlyBelowEpsilon) {
   for (const double delta : {1e-2, 1e-3, 1e-5}) {
     const Vec3 s(1.2, 1.2 - delta, 0.8);
     const TetPositions x = PositionsFromG(Ru * s.asDiagonal() * Rv.transpose(), X, Vec3::Zero());
-    const SignedSvd svd = CalcSignedSvd(CalcTetDeformationGradient(x, r));
+    const SignedSvd svd = CalcSignedSvd(CalcTetDeformationGradient(r, x));
     const bool small_gap = delta < 1e-2;
     for (int i = 0; i < 3; ++i) {
       const bool expect_active = small_gap && i != 2;  // column 3 has gaps 0.8 and 0.64
