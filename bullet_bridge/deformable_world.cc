@@ -1,6 +1,7 @@
 #include "bullet_bridge/deformable_world.h"
 
 #include <BulletCollision/CollisionDispatch/btCollisionDispatcher.h>
+#include <BulletDynamics/Dynamics/btRigidBody.h>
 
 #include <algorithm>
 #include <chrono>
@@ -102,6 +103,21 @@ EnergyLimitConstraint* DeformableWorld::SetEnergyLimits(DeformableBody* body,
       body, std::make_unique<EnergyLimitConstraint>(*body, limits, next_source_id_++));
 }
 
+void DeformableWorld::AttachNodesToRigidBody(DeformableBody* body, const std::vector<int>& nodes,
+                                             const btRigidBody* rigid) {
+  Entry& entry = FindEntry(body);
+  TAUT_DEMAND(rigid != nullptr, "AttachNodesToRigidBody: rigid body is null");
+  Entry::Attachment attachment{rigid, nodes, {}};
+  const btTransform inverse = rigid->getWorldTransform().inverse();
+  for (int node : nodes) {
+    TAUT_DEMAND(node >= 0 && node < body->num_nodes(), "body '", body->name(),
+                "': attached node ", node, " out of range [0, ", body->num_nodes(), ")");
+    attachment.local.push_back(ToEigen(inverse * ToBullet(body->node_position(node))));
+    body->SetKinematicTarget(node, body->node_position(node));
+  }
+  entry.attachments.push_back(std::move(attachment));
+}
+
 void DeformableWorld::ClearLimits(DeformableBody* body) { FindEntry(body).sources.clear(); }
 
 void DeformableWorld::RemoveDeformableBody(DeformableBody* body) {
@@ -138,6 +154,13 @@ void DeformableWorld::CollectStaticObjects(std::vector<const btCollisionObject*>
 
 void DeformableWorld::StepDeformableBodies(double h) {
   const Vec3 gravity = ToEigen(getGravity());
+  // Attached nodes follow their rigid bodies' current frames.
+  for (auto& entry : bodies_)
+    for (const auto& attachment : entry->attachments)
+      for (size_t k = 0; k < attachment.nodes.size(); ++k)
+        entry->body().SetKinematicTarget(
+            attachment.nodes[k],
+            ToEigen(attachment.rigid->getWorldTransform() * ToBullet(attachment.local[k])));
   auto t = std::chrono::steady_clock::now();
   for (auto& entry : bodies_) entry->body().BeginStep(h, gravity);
   stats_.ms_unconstrained = MsSince(t);

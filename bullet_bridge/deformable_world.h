@@ -52,6 +52,12 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   // C = 1 - U_e/U_max).
   // Replaces earlier energy limits of the body; throws InputError for invalid settings.
   EnergyLimitConstraint* SetEnergyLimits(DeformableBody* body, const EnergyLimitSettings& limits);
+  // Pins `nodes` of `body` to `rigid` (a bone driving soft flesh): every substep the nodes are
+  // driven kinematically to their rest offsets in the rigid body's current frame. One-way: the
+  // rigid body feels no reaction (use kinematic or static bodies). Throws InputError for a node
+  // out of range.
+  void AttachNodesToRigidBody(DeformableBody* body, const std::vector<int>& nodes,
+                              const btRigidBody* rigid);
   // Removes every constraint source (limits) of the body.
   void ClearLimits(DeformableBody* body);
   // Solver settings used by every constrained body.
@@ -79,6 +85,13 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
     std::unique_ptr<DeformableCollisionObject> object;
     std::vector<std::unique_ptr<ConstraintSource>> sources;
     std::unique_ptr<RigidContactSource> contacts;  // made when the world has static objects
+    // Nodes pinned to rigid bodies, with their offsets in the rigid body's frame.
+    struct Attachment {
+      const btRigidBody* rigid;
+      std::vector<int> nodes;
+      std::vector<Vec3> local;
+    };
+    std::vector<Attachment> attachments;
     SqpSolver solver;
     DeformableBody& body() { return object->body(); }
     btCollisionObject& collision_object() { return object->collision_object(); }

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "bullet_bridge/eigen_bullet.h"
 #include "demos/scenes/bullet_world_holder.h"
 #include "plugin/box_tet_mesher.h"
 
@@ -79,6 +80,52 @@ TEST(RigidContactTest, FrictionSticksBelowTheConeAndSlidesAboveIt) {
   EXPECT_LT(stick, 0.02);
   EXPECT_NEAR(slide, expected, 0.25 * expected);
   EXPECT_GT(slippery.MinZ(), -2e-3);
+}
+
+}  // namespace
+}  // namespace taut
+
+namespace taut {
+namespace {
+
+// A kinematic rigid "bone" lifts soft flesh pinned to it: the pinned nodes follow the bone's
+// frame exactly, the rest of the body hangs below and follows.
+TEST(RigidAttachmentTest, KinematicBoneDrivesPinnedSoftFlesh) {
+  BulletWorldHolder holder;
+  btBoxShape bone_shape(btVector3(0.1, 0.1, 0.02));
+  btDefaultMotionState bone_state(btTransform(btQuaternion::getIdentity(), btVector3(0, 0, 0.22)));
+  btRigidBody bone(0.0, &bone_state, &bone_shape);
+  bone.setCollisionFlags(bone.getCollisionFlags() | btCollisionObject::CF_KINEMATIC_OBJECT);
+  bone.setActivationState(DISABLE_DEACTIVATION);
+  holder.world.addRigidBody(&bone);
+  DeformableBodySettings settings;
+  settings.material = {2e4, 0.3, 500.0};
+  settings.mass_damping = 2.0;
+  DeformableBody* flesh =
+      holder.world.AddTetBody(MakeBoxTetMesh(Vec3(0.2, 0.2, 0.2), 2, 2, 2, Vec3(-0.1, -0.1, 0)),
+                              settings);
+  std::vector<int> top;
+  for (int i = 0; i < flesh->num_nodes(); ++i)
+    if (flesh->node_position(i).z() > 0.2 - 1e-9) top.push_back(i);
+  holder.world.AttachNodesToRigidBody(flesh, top, &bone);
+  // Lift the bone 0.5 m and turn it 30 degrees about z over 1 s (60 frames).
+  for (int frame = 1; frame <= 60; ++frame) {
+    const double t = frame / 60.0;
+    bone_state.setWorldTransform(btTransform(btQuaternion(btVector3(0, 0, 1), t * M_PI / 6),
+                                             btVector3(0, 0, 0.22 + 0.5 * t)));
+    holder.world.stepSimulation(1.0 / 60.0, 4, 1.0 / 240.0);
+  }
+  const btTransform& pose = bone.getWorldTransform();
+  const btTransform initial(btQuaternion::getIdentity(), btVector3(0, 0, 0.22));
+  for (int i : top) {
+    const btVector3 rest = ToBullet(flesh->model().rest_positions().segment<3>(3 * i));
+    const Vec3 expected = ToEigen(pose * (initial.inverse() * rest));
+    EXPECT_LT((flesh->node_position(i) - expected).norm(), 1e-9) << "node " << i;
+  }
+  double lowest = 1e9;
+  for (int i = 0; i < flesh->num_nodes(); ++i) lowest = std::min(lowest, flesh->node_position(i).z());
+  EXPECT_GT(lowest, 0.3);  // the whole body came up with the bone
+  holder.world.removeRigidBody(&bone);
 }
 
 }  // namespace
