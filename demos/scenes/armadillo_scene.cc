@@ -54,9 +54,8 @@ ArmadilloScene::ArmadilloScene(const std::vector<Material>& materials, const std
     for (Vec3& v : placed.vertices) v.x() += 2.0 * static_cast<double>(m);
     placed.source = materials[m].name;
     auto lattice = std::make_shared<HexLattice>(VoxelizeSurface(placed, kCellSize));
-    DeformableBodySettings settings;
-    settings.name = materials[m].name;
-    settings.material = {materials[m].youngs_modulus, 0.3, 500.0};
+    DeformableBodySettings settings =
+        MakeSceneBodySettings(materials[m].name, materials[m].youngs_modulus, 500.0);
     settings.contact_margin = 0.05;
     DeformableBody* body = world().AddHexBody(lattice, settings);
     limits_.push_back(materials[m].u_max ? world().SetEnergyLimits(

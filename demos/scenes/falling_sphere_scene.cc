@@ -23,9 +23,8 @@ FallingSphereScene::FallingSphereScene(const std::vector<Sphere>& spheres, doubl
     const Vec3 centre(3.0 * static_cast<double>(s), 0.0, kDropHeight + kRadius);
     auto lattice = std::make_shared<HexLattice>(MakeSphereHexLattice(kRadius, cell_size, centre));
     lattice->source = spheres[s].name;
-    DeformableBodySettings settings;
-    settings.name = spheres[s].name;
-    settings.material = {spheres[s].youngs_modulus, 0.3, 500.0};
+    DeformableBodySettings settings =
+        MakeSceneBodySettings(spheres[s].name, spheres[s].youngs_modulus, 500.0);
     settings.contact_margin = 0.05;
     DeformableBody* body = world().AddHexBody(lattice, settings);
     limits_.push_back(spheres[s].u_max ? world().SetEnergyLimits(

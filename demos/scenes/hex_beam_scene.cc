@@ -15,9 +15,7 @@ std::vector<HexBeamScene::Beam> HexBeamScene::DefaultBeams() {
   auto make = [](const std::string& name, double E, std::optional<double> u_max) {
     Beam beam;
     beam.name = name;
-    beam.settings.name = name;
-    beam.settings.material = {E, 0.3, 500.0};
-    beam.settings.mass_damping = 2.0;
+    beam.settings = MakeSceneBodySettings(name, E, 500.0, 2.0);
     beam.u_max = u_max;
     return beam;
   };

@@ -94,6 +94,15 @@ uint64_t Scene::CalcStateHash() const {
   return hash;
 }
 
+DeformableBodySettings MakeSceneBodySettings(const std::string& name, double youngs_modulus,
+                                             double density, double mass_damping) {
+  DeformableBodySettings settings;
+  settings.name = name;
+  settings.material = {youngs_modulus, 0.3, density};
+  settings.mass_damping = mass_damping;
+  return settings;
+}
+
 Vec3 CalcMeanDisplacement(const DeformableBody& body, const std::vector<int>& nodes) {
   Vec3 sum = Vec3::Zero();
   for (int i : nodes) sum += body.node_position(i) - body.model().rest_positions().segment<3>(3 * i);

@@ -51,6 +51,10 @@ class Scene {
   std::vector<EmbeddedSurfaceOutput> embedded_;
 };
 
+// Settings of a scene body: name, E [Pa], nu = 0.3, density [kg/m^3], Rayleigh alpha [1/s].
+DeformableBodySettings MakeSceneBodySettings(const std::string& name, double youngs_modulus,
+                                             double density, double mass_damping = 0.0);
+
 // Mean displacement x - X of the listed nodes of a body [m].
 Vec3 CalcMeanDisplacement(const DeformableBody& body, const std::vector<int>& nodes);
 

@@ -13,9 +13,7 @@ std::vector<TetBeamScene::Beam> TetBeamScene::DefaultBeams() {
   auto make = [](const std::string& name, double E, std::optional<StrainLimitSettings> limits) {
     Beam beam;
     beam.name = name;
-    beam.settings.name = name;
-    beam.settings.material = {E, 0.3, 1000.0};
-    beam.settings.mass_damping = 1.0;
+    beam.settings = MakeSceneBodySettings(name, E, 1000.0, 1.0);
     beam.limits = limits;
     return beam;
   };

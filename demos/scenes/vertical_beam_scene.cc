@@ -21,11 +21,9 @@ VerticalBeamScene::VerticalBeamScene(const std::vector<StrainProjection>& modes,
     const Vec3 corner(0.6 * static_cast<double>(c), 0.0, 0.0);
     auto mesh = std::make_shared<TetMesh>(
         MakeBoxTetMesh(Vec3(kWidth, kWidth, kHeight), cells_xy, cells_xy, cells_z, corner));
-    DeformableBodySettings settings;
-    settings.name = std::string("column_") + GetStrainProjectionName(modes[c]);
+    const DeformableBodySettings settings = MakeSceneBodySettings(
+        std::string("column_") + GetStrainProjectionName(modes[c]), 10e3, 1000.0, 1.0);
     mesh->source = settings.name;
-    settings.material = {10e3, 0.3, 1000.0};
-    settings.mass_damping = 1.0;
     DeformableBody* body = world().AddTetBody(mesh, settings);
     body->FixNodesWhere([](const Vec3& X) { return X.z() < 1e-9; });
     // Transverse axis x limited to 0.95..1.05; y and the vertical axis z free.
