@@ -12,7 +12,7 @@ namespace taut {
 
 // Rigid objects are treated as immovable during the step (static, or kinematic with the motion
 // Bullet gave them). Two-way coupling with dynamic rigid bodies is not part of this source.
-class RigidContactSource final : public ConstraintSource {
+class RigidContactSource final : public BodyConstraintSource {
  public:
   // `friction` is the body's Coulomb coefficient, combined with each object's by the product
   // (Bullet's default combiner); `margin` [m] is how close a node must be to get rows.

@@ -1,10 +1,13 @@
 // One linearized constraint row of an island and the interface of everything that emits rows.
 #pragma once
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
+#include "constraints/island_body.h"
 #include "plugin/deformable_body.h"
 
 namespace taut {
@@ -13,16 +16,26 @@ namespace taut {
 constexpr int kMaxRowNodes = 8;
 
 // What a row constrains, for statistics.
-enum class RowType : std::uint8_t { kStrainLimit, kEnergyLimit, kContact };
+enum class RowType : std::uint8_t {
+  kStrainLimit,
+  kEnergyLimit,
+  kContact,       // deformable against rigid or deformable (normal and friction rows)
+  kRigidContact,  // Bullet's rigid-rigid contact inside a deformable island
+  kJoint,         // Bullet joint rows and node attachments (bilateral)
+};
 
-// C(x) >= 0 linearized at the current iterate: C + J dx >= 0, with J sparse over the nodes of one
-// deformable body (MATH.md §5). C is dimensionless for limit rows, J in 1/m.
+// C(x) >= 0 linearized at the current iterate: C + J dx >= 0 (MATH.md §5), or C = 0 for a
+// bilateral row. J is sparse over at most two island bodies ("sides"): the nodes of side A
+// (body, nodes, J) and optionally of side B (body2, nodes2, J2). A rigid island body has two
+// velocity blocks, linear (block 0) and angular (block 1). C is dimensionless for limit rows, J
+// in 1/m; contact rows have C in m and dimensionless J.
 struct ConstraintRow {
   std::uint64_t key = 0;  // identity for warm starting (source id and element, axis, bound)
-  double C = 0.0;         // value at the iterate, >= 0 feasible
-  int body = -1;          // index of the deformable body in the island
+  double C = 0.0;         // value at the iterate, >= 0 feasible (bilateral: = 0 feasible)
+  int body = -1;          // index of side A's body in the island
   int num_nodes = 0;
   RowType type = RowType::kStrainLimit;
+  bool bilateral = false;  // C = 0 with a free multiplier (joints, attachments)
   // Friction rows (contact tangents): 1 or 2 = how many rows back the contact's normal row is;
   // 0 for unilateral rows. A friction row targets J v = 0 within the Coulomb disk of radius
   // mu lambda_n; its C is unused.
@@ -30,12 +43,41 @@ struct ConstraintRow {
   double mu = 0.0;  // Coulomb coefficient of a friction row
   std::array<int, kMaxRowNodes> nodes{};  // node indices in the body
   std::array<Vec3, kMaxRowNodes> J{};     // dC/dx_node
+  int body2 = -1;                          // side B's body in the island, -1 when one-sided
+  int num_nodes2 = 0;
+  std::array<int, kMaxRowNodes> nodes2{};
+  std::array<Vec3, kMaxRowNodes> J2{};
+
+  // Calls f(body, block, J) for every velocity block the row touches, both sides.
+  template <typename F>
+  void ForEachEntry(F&& f) const {
+    for (int n = 0; n < num_nodes; ++n) f(body, nodes[n], J[n]);
+    for (int n = 0; n < num_nodes2; ++n) f(body2, nodes2[n], J2[n]);
+  }
+  // Violation of the row at its C: max(0, -C) (bilateral |C|; friction rows 0).
+  double violation() const {
+    if (friction_of > 0) return 0.0;
+    return bilateral ? std::abs(C) : std::max(0.0, -C);
+  }
 };
 
-// A family of unilateral constraints on one deformable body (strain limits, energy limits).
+// Anything that emits rows for an island (limits, contacts, joints), evaluated at an iterate.
 class ConstraintSource {
  public:
   virtual ~ConstraintSource() = default;
+  // Appends the rows active at the iterate (violated or within the activation margin). Returns
+  // how many were appended.
+  virtual int AppendIslandRows(const IslandIterate& iterate, std::vector<ConstraintRow>& rows) = 0;
+  // Largest violation (max(0, -C), bilateral |C|) over every constraint of the source.
+  virtual double CalcIslandMaxViolation(const IslandIterate& iterate) const = 0;
+  // Sum of violations over every constraint (the merit function's penalty).
+  virtual double CalcIslandViolationSum(const IslandIterate& iterate) const = 0;
+};
+
+// A family of unilateral constraints on one deformable body (strain limits, energy limits,
+// contacts with immovable objects), evaluated at that body's positions.
+class BodyConstraintSource : public ConstraintSource {
+ public:
   // The body the rows act on.
   virtual const DeformableBody& body() const = 0;
   // Appends the rows that are violated or within the activation margin at positions x (3N),
@@ -45,6 +87,18 @@ class ConstraintSource {
   virtual double CalcMaxViolation(const VecX& x) const = 0;
   // Sum of violations max(0, -C) over every constraint at x (the merit function's penalty).
   virtual double CalcViolationSum(const VecX& x) const = 0;
+
+  // The island interface, through the body's positions at the iterate.
+  int AppendIslandRows(const IslandIterate& iterate, std::vector<ConstraintRow>& rows) override {
+    const int b = iterate.IndexOf(&body());
+    return AppendRows(iterate.x(b), b, rows);
+  }
+  double CalcIslandMaxViolation(const IslandIterate& iterate) const override {
+    return CalcMaxViolation(iterate.x(iterate.IndexOf(&body())));
+  }
+  double CalcIslandViolationSum(const IslandIterate& iterate) const override {
+    return CalcViolationSum(iterate.x(iterate.IndexOf(&body())));
+  }
 };
 
 }  // namespace taut

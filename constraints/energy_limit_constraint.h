@@ -14,7 +14,7 @@ namespace taut {
 // Emits one row C = 1 - U_e/U_max,e per element (tet: 4 nodes, exact gradient; hex: 8 nodes,
 // J = f_e/U_max with the element rotation frozen at x, MATH.md §4) whose C is below the activation
 // margin.
-class EnergyLimitConstraint final : public ConstraintSource {
+class EnergyLimitConstraint final : public BodyConstraintSource {
  public:
   // `body` must be a tet or hex body; settings are validated (throws InputError naming the body).
   // `source_id` (< 2^16) makes row keys unique among the sources of a world.

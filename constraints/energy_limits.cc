@@ -37,6 +37,9 @@ EnergyLimitSettings EnergyLimitSettings::EnergyDensity(double density) {
 }
 
 void EnergyLimitSettings::Validate(int num_elements, const std::string& where) const {
+  TAUT_DEMAND(unit == EnergyLimitUnit::kEnergy || unit == EnergyLimitUnit::kEnergyDensity, where,
+              ": unknown energy limit unit ", static_cast<int>(unit),
+              "; valid: kEnergy (J) or kEnergyDensity (J/m^3)");
   if (element_u_max.empty()) {
     DemandLimit(u_max, unit, "energy limit u_max", where);
   } else {

@@ -39,9 +39,9 @@ struct EnergyLimitSettings {
   // U_e <= density * V_e for every element (density in J/m^3, V_e the rest volume).
   static EnergyLimitSettings EnergyDensity(double density);
 
-  // Throws InputError naming `where`, the quantity, the element and the valid range when a limit
-  // is NaN or <= 0, the number of per-element limits differs from num_elements, or the margin is
-  // NaN or negative.
+  // Throws InputError naming `where`, the quantity, the element and the valid range when the unit
+  // is not an EnergyLimitUnit value, a limit is NaN or <= 0, the number of per-element limits
+  // differs from num_elements, or the margin is NaN or negative.
   void Validate(int num_elements, const std::string& where) const;
 };
 

@@ -1,6 +1,7 @@
 #include "constraints/sqp_solver.h"
 
 #include "constraints/active_set_polish.h"
+#include "constraints/deformable_island_body.h"
 
 #include <algorithm>
 #include <chrono>
@@ -16,7 +17,7 @@ double MsSince(std::chrono::steady_clock::time_point start) {
 }
 
 // ||dv||_A^2 = dv^T A dv summed over bodies (dv read on free DOFs).
-double EnergyNormSquared(const std::vector<DeformableBody*>& bodies, const std::vector<VecX>& dv,
+double EnergyNormSquared(const std::vector<IslandBody*>& bodies, const std::vector<VecX>& dv,
                          VecX& scratch) {
   double sum = 0.0;
   for (size_t b = 0; b < bodies.size(); ++b) {
@@ -27,64 +28,71 @@ double EnergyNormSquared(const std::vector<DeformableBody*>& bodies, const std::
 }
 }  // namespace
 
-double SqpSolver::CollectRows(double h, const std::vector<DeformableBody*>& bodies,
+void SqpSolver::CalcPositions(double h, const std::vector<IslandBody*>& bodies,
+                              const std::vector<VecX>& v) {
+  for (size_t b = 0; b < bodies.size(); ++b) bodies[b]->CalcPositions(h, v[b], x_[b]);
+}
+
+double SqpSolver::CollectRows(double h, const std::vector<IslandBody*>& bodies,
                               const std::vector<ConstraintSource*>& sources) {
   rows_.clear();
-  for (ConstraintSource* source : sources) {
-    const auto it = std::find(bodies.begin(), bodies.end(), &source->body());
-    const int b = static_cast<int>(it - bodies.begin());
-    // x_k = x0 + h v_k of that body.
-    v_trial_[b] = bodies[b]->x0() + h * v_k_[b];
-    source->AppendRows(v_trial_[b], b, rows_);
-  }
+  CalcPositions(h, bodies, v_k_);
+  const IslandIterate iterate(h, bodies, v_k_, x_);
+  for (ConstraintSource* source : sources) source->AppendIslandRows(iterate, rows_);
   double violation = 0.0;
-  for (const ConstraintRow& row : rows_) violation = std::max(violation, -row.C);
-  body_rows_.assign(bodies.size(), {});
-  for (size_t c = 0; c < rows_.size(); ++c) body_rows_[rows_[c].body].push_back(static_cast<int>(c));
+  for (const ConstraintRow& row : rows_) violation = std::max(violation, row.violation());
+  body_rows_.resize(bodies.size());
+  for (auto& rows : body_rows_) rows.clear();
+  for (size_t c = 0; c < rows_.size(); ++c) {
+    body_rows_[rows_[c].body].push_back(static_cast<int>(c));
+    if (rows_[c].body2 >= 0 && rows_[c].body2 != rows_[c].body)
+      body_rows_[rows_[c].body2].push_back(static_cast<int>(c));
+  }
   return violation;
 }
 
-void SqpSolver::BuildDelassus(const std::vector<DeformableBody*>& bodies) {
+void SqpSolver::BuildDelassus(const std::vector<IslandBody*>& bodies) {
   const int m = static_cast<int>(rows_.size());
   W_.setZero(m, m);
   Y_.resize(bodies.size());
   for (size_t b = 0; b < bodies.size(); ++b) {
     const std::vector<int>& rows = body_rows_[b];
     if (rows.empty()) continue;
-    // Y_b = A^-1 J_b^T: scatter J rows into columns, then one multi-column solve.
+    const int body = static_cast<int>(b);
+    // Y_b = A_b^-1 J_b^T: scatter the row's entries on body b into columns, one multi-column
+    // solve.
     MatX& Y = Y_[b];
-    Y.setZero(3 * bodies[b]->num_nodes(), static_cast<int>(rows.size()));
+    Y.setZero(3 * bodies[b]->num_blocks(), static_cast<int>(rows.size()));
     for (size_t k = 0; k < rows.size(); ++k) {
-      const ConstraintRow& row = rows_[rows[k]];
-      for (int n = 0; n < row.num_nodes; ++n) Y.col(k).segment<3>(3 * row.nodes[n]) += row.J[n];
+      rows_[rows[k]].ForEachEntry([&](int on, int block, const Vec3& J) {
+        if (on == body) Y.col(k).segment<3>(3 * block) += J;
+      });
     }
     bodies[b]->SolveSystemColumns(Y);
-    // W_c. = J_c Y (J sparse over a row's nodes): a 1x3 times 3xm product per node.
+    // W_c. += J_cb Y_b (J sparse over a row's blocks): a 1x3 times 3xm product per block.
     for (size_t i = 0; i < rows.size(); ++i) {
-      const ConstraintRow& row = rows_[rows[i]];
       w_row_.setZero(static_cast<int>(rows.size()));
-      for (int n = 0; n < row.num_nodes; ++n)
-        w_row_.noalias() += row.J[n].transpose() * Y.middleRows<3>(3 * row.nodes[n]);
-      for (size_t k = 0; k < rows.size(); ++k) W_(rows[i], rows[k]) = w_row_[k];
+      rows_[rows[i]].ForEachEntry([&](int on, int block, const Vec3& J) {
+        if (on == body) w_row_.noalias() += J.transpose() * Y.middleRows<3>(3 * block);
+      });
+      for (size_t k = 0; k < rows.size(); ++k) W_(rows[i], rows[k]) += w_row_[k];
     }
   }
   // Symmetrize (W is J A^-1 J^T; round-off makes it slightly asymmetric).
   W_ = 0.5 * (W_ + W_.transpose()).eval();
 }
 
-double SqpSolver::CalcViolationSum(double h, const std::vector<DeformableBody*>& bodies,
+double SqpSolver::CalcViolationSum(double h, const std::vector<IslandBody*>& bodies,
                                    const std::vector<ConstraintSource*>& sources,
                                    const std::vector<VecX>& v) {
+  CalcPositions(h, bodies, v);
+  const IslandIterate iterate(h, bodies, v, x_);
   double sum = 0.0;
-  for (ConstraintSource* source : sources) {
-    const int b = static_cast<int>(std::find(bodies.begin(), bodies.end(), &source->body()) -
-                                   bodies.begin());
-    sum += source->CalcViolationSum(bodies[b]->x0() + h * v[b]);
-  }
+  for (ConstraintSource* source : sources) sum += source->CalcIslandViolationSum(iterate);
   return sum;
 }
 
-double SqpSolver::CalcMerit(double h, const std::vector<DeformableBody*>& bodies,
+double SqpSolver::CalcMerit(double h, const std::vector<IslandBody*>& bodies,
                             const std::vector<ConstraintSource*>& sources,
                             const std::vector<VecX>& v, double rho) {
   for (size_t b = 0; b < bodies.size(); ++b) dv_[b] = v[b] - bodies[b]->v_star();
@@ -94,7 +102,8 @@ double SqpSolver::CalcMerit(double h, const std::vector<DeformableBody*>& bodies
 
 double SqpSolver::CalcRowVelocity(const ConstraintRow& row, const std::vector<VecX>& v) const {
   double jv = 0.0;
-  for (int n = 0; n < row.num_nodes; ++n) jv += row.J[n].dot(v[row.body].segment<3>(3 * row.nodes[n]));
+  row.ForEachEntry(
+      [&](int body, int block, const Vec3& J) { jv += J.dot(v[body].segment<3>(3 * block)); });
   return jv;
 }
 
@@ -103,6 +112,7 @@ void SqpSolver::BuildPgsRows() {
   pgs_rows_.assign(rows_.size(), MakeUnilateralRow());
   for (size_t c = 0; c < rows_.size(); ++c) {
     const ConstraintRow& row = rows_[c];
+    if (row.bilateral) pgs_rows_[c] = MakeBilateralRow();
     if (row.friction_of == 0) continue;
     PgsRow& p = pgs_rows_[c];
     p.kind = RowKind::kFriction;
@@ -133,7 +143,18 @@ void SqpSolver::StoreMultipliers(std::vector<std::pair<std::uint64_t, double>>& 
 void SqpSolver::Solve(double h, const std::vector<DeformableBody*>& bodies,
                       const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
                       StepStats& stats) {
+  std::vector<DeformableIslandBody> adapters;
+  adapters.reserve(bodies.size());
+  std::vector<IslandBody*> island;
+  for (DeformableBody* body : bodies) island.push_back(&adapters.emplace_back(*body));
+  Solve(h, island, sources, settings, stats);
+}
+
+void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
+                      const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
+                      StepStats& stats) {
   const size_t nb = bodies.size();
+  x_.resize(nb);
   v_k_.resize(nb);
   v_qp_.resize(nb);
   v_trial_.resize(nb);
@@ -158,6 +179,11 @@ void SqpSolver::Solve(double h, const std::vector<DeformableBody*>& bodies,
         rows_.begin(), rows_.end(), [](const auto& r) { return r.type == RowType::kEnergyLimit; }));
     stats.rows_contact = static_cast<int>(std::count_if(
         rows_.begin(), rows_.end(), [](const auto& r) { return r.type == RowType::kContact; }));
+    stats.rows_rigid_contact = static_cast<int>(
+        std::count_if(rows_.begin(), rows_.end(),
+                      [](const auto& r) { return r.type == RowType::kRigidContact; }));
+    stats.rows_joint = static_cast<int>(std::count_if(
+        rows_.begin(), rows_.end(), [](const auto& r) { return r.type == RowType::kJoint; }));
     WarmStart(iterate_);
     if (rows_.empty()) {
       lambda_.resize(0);
@@ -170,12 +196,14 @@ void SqpSolver::Solve(double h, const std::vector<DeformableBody*>& bodies,
       bodies[b]->ApplySystemMatrix(dv_[b], scratch_);
       VecX& jt = jt_;
       jt.setZero(scratch_.size());
+      const int body = static_cast<int>(b);
       for (int c : body_rows_[b])
-        for (int n = 0; n < rows_[c].num_nodes; ++n)
-          jt.segment<3>(3 * rows_[c].nodes[n]) += lambda_[c] * rows_[c].J[n];
+        rows_[c].ForEachEntry([&](int on, int block, const Vec3& J) {
+          if (on == body) jt.segment<3>(3 * block) += lambda_[c] * J;
+        });
       // Constrained DOFs carry reaction forces: compare on free DOFs only (A v is 0 there).
-      for (int i = 0; i < bodies[b]->num_nodes(); ++i)
-        if (bodies[b]->node_kind(i) != NodeKind::kFree) jt.segment<3>(3 * i).setZero();
+      for (int i = 0; i < bodies[b]->num_blocks(); ++i)
+        if (!bodies[b]->is_free_block(i)) jt.segment<3>(3 * i).setZero();
       residual += (scratch_ - jt).squaredNorm();
       force += jt.squaredNorm();
     }
@@ -206,9 +234,10 @@ void SqpSolver::Solve(double h, const std::vector<DeformableBody*>& bodies,
     for (int c = 0; c < m; ++c) {
       const ConstraintRow& row = rows_[c];
       double jdv = 0.0;
-      for (int n = 0; n < row.num_nodes; ++n)
-        jdv += row.J[n].dot(bodies[row.body]->v_star().segment<3>(3 * row.nodes[n]) -
-                            v_k_[row.body].segment<3>(3 * row.nodes[n]));
+      row.ForEachEntry([&](int body, int block, const Vec3& J) {
+        jdv += J.dot(bodies[body]->v_star().segment<3>(3 * block) -
+                     v_k_[body].segment<3>(3 * block));
+      });
       q_[c] = restoring ? row.C / h : row.C / h + jdv;
       // Friction rows: w_t = J_t v = J_t (v* + Y lambda), so q = J_t v* (restoration: 0).
       if (row.friction_of > 0) q_[c] = restoring ? 0.0 : jdv + CalcRowVelocity(row, v_k_);
@@ -253,7 +282,7 @@ void SqpSolver::Solve(double h, const std::vector<DeformableBody*>& bodies,
       continue;
     }
     // Merit backtracking.
-    rho = std::max(rho, 2.0 * lambda_qp_.maxCoeff());
+    rho = std::max(rho, 2.0 * lambda_qp_.cwiseAbs().maxCoeff());
     const double phi_k = CalcMerit(h, bodies, sources, v_k_, rho);
     for (size_t b = 0; b < nb; ++b) dv_[b] = v_qp_[b] - v_k_[b];
     const double step_norm = EnergyNormSquared(bodies, dv_, scratch_);
@@ -270,7 +299,7 @@ void SqpSolver::Solve(double h, const std::vector<DeformableBody*>& bodies,
     stats.sqp_iterations = k + 1;
     stats.ms_solve += MsSince(t_solve);
   }
-  for (size_t b = 0; b < nb; ++b) bodies[b]->mutable_v() = v_k_[b];
+  for (size_t b = 0; b < nb; ++b) bodies[b]->set_v(v_k_[b]);
   StoreMultipliers(previous_);
 }
 

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "constraints/constraint_row.h"
+#include "constraints/island_body.h"
 #include "constraints/active_set_polish.h"
 #include "constraints/pgs_solver.h"
 #include "constraints/step_stats.h"
@@ -39,26 +40,33 @@ struct SqpSettings {
 //   alpha halved while phi(v_k + alpha (v_QP - v_k)) > phi(v_k) - 1e-4 alpha ||v_QP - v_k||_A^2,
 //   phi(v) = 1/2 ||v - v*||_A^2 + rho sum max(0, -C)/h, rho >= 2 max lambda (non-decreasing);
 //   v, lambda <- v_k + alpha (QP - k).
+// Bilateral rows (joints, attachments) enter with a free multiplier and violation |C|.
 // Bodies enter with v = v* (after BeginStep) and leave with the constrained v.
 class SqpSolver {
  public:
-  // Solves one step of length h; fills the constraint part of `stats`.
+  // Solves one step of length h for the island `bodies`; fills the constraint part of `stats`.
+  void Solve(double h, const std::vector<IslandBody*>& bodies,
+             const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
+             StepStats& stats);
+  // Same for deformable bodies only (wraps them; allocates, for tests and tools).
   void Solve(double h, const std::vector<DeformableBody*>& bodies,
              const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
              StepStats& stats);
 
  private:
-  // Rows of every source at the current iterate; returns max(0, -C) over them.
-  double CollectRows(double h, const std::vector<DeformableBody*>& bodies,
+  // Positions x_b of every body at velocities v.
+  void CalcPositions(double h, const std::vector<IslandBody*>& bodies, const std::vector<VecX>& v);
+  // Rows of every source at the current iterate; returns the largest row violation.
+  double CollectRows(double h, const std::vector<IslandBody*>& bodies,
                      const std::vector<ConstraintSource*>& sources);
   // Y_b = A_b^-1 J_b^T per body and W = J Y.
-  void BuildDelassus(const std::vector<DeformableBody*>& bodies);
-  // Sum of violations max(0, -C) of every source at velocities v (per body).
-  double CalcViolationSum(double h, const std::vector<DeformableBody*>& bodies,
+  void BuildDelassus(const std::vector<IslandBody*>& bodies);
+  // Sum of violations of every source at velocities v (per body).
+  double CalcViolationSum(double h, const std::vector<IslandBody*>& bodies,
                           const std::vector<ConstraintSource*>& sources,
                           const std::vector<VecX>& v);
   // Merit phi at velocities v (per body) with penalty weight rho.
-  double CalcMerit(double h, const std::vector<DeformableBody*>& bodies,
+  double CalcMerit(double h, const std::vector<IslandBody*>& bodies,
                    const std::vector<ConstraintSource*>& sources, const std::vector<VecX>& v,
                    double rho);
   // J v of a row for per-body velocities v.
@@ -74,6 +82,7 @@ class SqpSolver {
   std::vector<PgsRow> pgs_rows_;
   std::vector<std::vector<int>> body_rows_;  // (num_bodies) rows of each body
   std::vector<MatX> Y_;                      // (num_bodies) 3N x rows of the body
+  std::vector<VecX> x_;                      // (num_bodies) positions at the iterate
   MatX W_;
   VecX q_, lambda_, lambda_qp_, w_;
   Eigen::RowVectorXd w_row_;  // one row of W being assembled

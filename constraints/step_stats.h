@@ -15,7 +15,9 @@ struct StepStats {
   // Constraint work.
   int rows_strain = 0;            // active strain-limit rows (last SQP iteration)
   int rows_energy = 0;            // active energy-limit rows
-  int rows_contact = 0;           // contact normal + friction rows
+  int rows_contact = 0;           // deformable contact normal + friction rows
+  int rows_rigid_contact = 0;     // Bullet rigid-rigid contact rows inside deformable islands
+  int rows_joint = 0;             // Bullet joint and node attachment rows (bilateral)
   int pgs_sweeps = 0;             // total over SQP iterations
   int active_set_solves = 0;      // QPs refined by a direct active-set solve
   int sqp_iterations = 0;         // including restoration iterations
@@ -25,7 +27,13 @@ struct StepStats {
   double stationarity = 0.0;      // ||A(v - v*) - J^T lambda|| / ||J^T lambda|| at the end
   bool converged = true;          // violation within tolerance at the end (false: caps reached)
 
-  int rows_total() const { return rows_strain + rows_energy + rows_contact; }
+  int islands = 0;                // islands solved by the SQP (with at least one row source)
+  int rigid_bodies_coupled = 0;   // dynamic rigid bodies solved inside deformable islands
+  double max_penetration = 0.0;   // deepest deformable contact penetration at the end [m]
+
+  int rows_total() const {
+    return rows_strain + rows_energy + rows_contact + rows_rigid_contact + rows_joint;
+  }
 };
 
 }  // namespace taut

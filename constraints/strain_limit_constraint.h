@@ -8,7 +8,7 @@
 namespace taut {
 
 // Emits the strain-limit rows of every tet of a body whose C is below the activation margin.
-class StrainLimitConstraint final : public ConstraintSource {
+class StrainLimitConstraint final : public BodyConstraintSource {
  public:
   // `body` must be a tet body; settings are validated (throws InputError naming the body).
   // `source_id` (< 2^16) makes row keys unique among the sources of a world.

@@ -39,6 +39,11 @@ StrainLimitSettings StrainLimitSettings::PerAxis(const Vec3& s_min, const Vec3& 
 }
 
 void StrainLimitSettings::Validate(int num_elements, const std::string& where) const {
+  const int mode = static_cast<int>(projection);
+  TAUT_DEMAND(mode >= static_cast<int>(StrainProjection::kHyperbolic) &&
+                  mode <= static_cast<int>(StrainProjection::kEllipsoid),
+              where, ": unknown strain projection ", mode,
+              "; valid: kHyperbolic, kOrthogonal, kLinearInterpolation, kEllipsoid");
   for (int j = 0; j < 3; ++j) {
     const double lo = s_min[j];
     const double hi = s_max[j];

@@ -65,8 +65,9 @@ struct StrainLimitSettings {
                                      StrainProjection projection = StrainProjection::kHyperbolic);
 
   // Throws InputError naming `where`, the quantity, the axis or element and the valid range when a
-  // limit is NaN or out of range, s_min > s_max, a frame is not a rotation, the number of element
-  // frames differs from num_elements, or a cap / margin / epsilon is out of range.
+  // limit is NaN or out of range, s_min > s_max, the projection is not a StrainProjection value, a
+  // frame is not a rotation, the number of element frames differs from num_elements, or a cap /
+  // margin / epsilon is out of range.
   void Validate(int num_elements, const std::string& where) const;
 };
 

@@ -1,0 +1,35 @@
+// A deformable body as an island body (one velocity block per node).
+#pragma once
+
+#include "constraints/island_body.h"
+#include "plugin/deformable_body.h"
+
+namespace taut {
+
+// Adapter: A, v* and v are the body's own (between BeginStep and EndStep).
+class DeformableIslandBody final : public IslandBody {
+ public:
+  explicit DeformableIslandBody(DeformableBody& body) : body_(&body) {}
+  int num_blocks() const override { return body_->num_nodes(); }
+  const VecX& v_star() const override { return body_->v_star(); }
+  const VecX& v() const override { return body_->v(); }
+  void set_v(const VecX& v) override { body_->mutable_v() = v; }
+  void SolveSystemColumns(Eigen::Ref<MatX> columns) const override {
+    body_->SolveSystemColumns(columns);
+  }
+  void ApplySystemMatrix(const VecX& v, VecX& out) const override {
+    body_->ApplySystemMatrix(v, out);
+  }
+  bool is_free_block(int i) const override { return body_->node_kind(i) == NodeKind::kFree; }
+  // x = x0 + h v (MATH.md §5: positions of the backward-Euler step).
+  void CalcPositions(double h, const VecX& v, VecX& x) const override {
+    x = body_->x0() + h * v;
+  }
+  const DeformableBody* deformable() const override { return body_; }
+  DeformableBody& body() { return *body_; }
+
+ private:
+  DeformableBody* body_;
+};
+
+}  // namespace taut

@@ -1,0 +1,69 @@
+// A body of a constraint island as the SQP sees it (MATH.md §5): velocity blocks, the step's
+// system matrix A, the unconstrained velocity v*, and positions at a velocity.
+#pragma once
+
+#include <vector>
+
+#include "plugin/common.h"
+
+namespace taut {
+
+class DeformableBody;
+
+// Deformable bodies have one 3-vector block per node (A = M + h D + h^2 K); rigid bodies have
+// two, linear and angular velocity (A = diag(m I, I_world)). The SQP only needs A^-1 columns,
+// A v products, v* and the current v.
+class IslandBody {
+ public:
+  virtual ~IslandBody() = default;
+  // Number of 3-vector velocity blocks.
+  virtual int num_blocks() const = 0;
+  // Unconstrained velocity of this step (3 * num_blocks).
+  virtual const VecX& v_star() const = 0;
+  // Current velocity (the SQP's iterate is written back here at the end of a solve).
+  virtual const VecX& v() const = 0;
+  virtual void set_v(const VecX& v) = 0;
+  // columns <- A^-1 columns (zero on blocks that do not move freely).
+  virtual void SolveSystemColumns(Eigen::Ref<MatX> columns) const = 0;
+  // out = A v (zero on blocks that do not move freely).
+  virtual void ApplySystemMatrix(const VecX& v, VecX& out) const = 0;
+  // False for blocks pinned by the body itself (fixed or kinematic nodes).
+  virtual bool is_free_block(int i) const = 0;
+  // Positions after a step h at velocity v, for sources that read node positions (deformable:
+  // x0 + h v). Bodies without nodes leave x empty.
+  virtual void CalcPositions(double h, const VecX& v, VecX& x) const = 0;
+  // The deformable body behind this island body, or null.
+  virtual const DeformableBody* deformable() const { return nullptr; }
+};
+
+// The bodies of an island with velocities and positions of one SQP iterate.
+class IslandIterate {
+ public:
+  IslandIterate(double h, const std::vector<IslandBody*>& bodies, const std::vector<VecX>& v,
+                const std::vector<VecX>& x)
+      : h_(h), bodies_(bodies), v_(v), x_(x) {}
+  double h() const { return h_; }
+  int num_bodies() const { return static_cast<int>(bodies_.size()); }
+  IslandBody& body(int b) const { return *bodies_[b]; }
+  const VecX& v(int b) const { return v_[b]; }
+  const VecX& x(int b) const { return x_[b]; }
+  // Island index of a body; throws InputError when it is not in the island.
+  int IndexOf(const IslandBody* body) const {
+    for (size_t b = 0; b < bodies_.size(); ++b)
+      if (bodies_[b] == body) return static_cast<int>(b);
+    throw InputError("island: body is not part of this island");
+  }
+  int IndexOf(const DeformableBody* body) const {
+    for (size_t b = 0; b < bodies_.size(); ++b)
+      if (bodies_[b]->deformable() == body) return static_cast<int>(b);
+    throw InputError("island: deformable body is not part of this island");
+  }
+
+ private:
+  double h_;
+  const std::vector<IslandBody*>& bodies_;
+  const std::vector<VecX>& v_;
+  const std::vector<VecX>& x_;
+};
+
+}  // namespace taut
