@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
 
 #include "bullet_bridge/eigen_bullet.h"
 #include "plugin/tet_element_model.h"
@@ -66,6 +67,10 @@ DeformableBody* DeformableWorld::AddDeformableBody(std::unique_ptr<DeformableBod
   TAUT_DEMAND(body != nullptr, "AddDeformableBody: body is null");
   auto entry = std::make_unique<Entry>();
   entry->object = std::make_unique<DeformableCollisionObject>(std::move(body));
+  entry->island_body = std::make_unique<DeformableIslandBody>(entry->object->body());
+  DeformableBody& added = entry->object->body();
+  entry->contacts = std::make_unique<RigidContactSource>(
+      added, next_source_id_++, added.settings().friction, added.settings().contact_margin);
   bodies_.push_back(std::move(entry));
   addCollisionObject(&bodies_.back()->collision_object(), btBroadphaseProxy::DefaultFilter,
                      btBroadphaseProxy::AllFilter);
@@ -103,19 +108,36 @@ EnergyLimitConstraint* DeformableWorld::SetEnergyLimits(DeformableBody* body,
       body, std::make_unique<EnergyLimitConstraint>(*body, limits, next_source_id_++));
 }
 
+RigidIslandBody* DeformableWorld::FindRigidIslandBody(btRigidBody* rigid) {
+  auto& slot = rigid_bodies_[rigid];
+  if (slot == nullptr) slot = std::make_unique<RigidIslandBody>(rigid);
+  return slot.get();
+}
+
 void DeformableWorld::AttachNodesToRigidBody(DeformableBody* body, const std::vector<int>& nodes,
                                              const btRigidBody* rigid) {
   Entry& entry = FindEntry(body);
   TAUT_DEMAND(rigid != nullptr, "AttachNodesToRigidBody: rigid body is null");
-  Entry::Attachment attachment{rigid, nodes, {}};
+  // The world's own (non-const) pointer to the rigid body.
+  btRigidBody* owned = nullptr;
+  for (int i = 0; i < getNumCollisionObjects(); ++i)
+    if (getCollisionObjectArray()[i] == rigid) owned = btRigidBody::upcast(getCollisionObjectArray()[i]);
+  TAUT_DEMAND(owned != nullptr, "body '", body->name(),
+              "': AttachNodesToRigidBody: the rigid body is not in this world");
   const btTransform inverse = rigid->getWorldTransform().inverse();
+  std::vector<Vec3> local;
   for (int node : nodes) {
     TAUT_DEMAND(node >= 0 && node < body->num_nodes(), "body '", body->name(),
                 "': attached node ", node, " out of range [0, ", body->num_nodes(), ")");
-    attachment.local.push_back(ToEigen(inverse * ToBullet(body->node_position(node))));
-    body->SetKinematicTarget(node, body->node_position(node));
+    local.push_back(ToEigen(inverse * ToBullet(body->node_position(node))));
   }
-  entry.attachments.push_back(std::move(attachment));
+  if (rigid->isStaticOrKinematicObject()) {
+    for (int node : nodes) body->SetKinematicTarget(node, body->node_position(node));
+    entry.attachments.push_back({rigid, nodes, std::move(local)});
+    return;
+  }
+  entry.dynamic_attachments.push_back(std::make_unique<NodeAttachmentSource>(
+      *body, FindRigidIslandBody(owned), nodes, std::move(local), next_source_id_++));
 }
 
 void DeformableWorld::ClearLimits(DeformableBody* body) { FindEntry(body).sources.clear(); }
@@ -134,71 +156,214 @@ void DeformableWorld::internalSingleStepSimulation(btScalar h) {
     return;
   }
   const auto start = std::chrono::steady_clock::now();
-  stats_ = StepStats();
-  StepDeformableBodies(static_cast<double>(h));
-  const auto rigid_start = std::chrono::steady_clock::now();
-  btDiscreteDynamicsWorld::internalSingleStepSimulation(h);  // also refreshes every AABB
-  stats_.ms_rigid = MsSince(rigid_start);
+  btDiscreteDynamicsWorld::internalSingleStepSimulation(h);  // calls solveConstraints below
   stats_.ms_total = MsSince(start);
+  stats_.ms_rigid = stats_.ms_total - stats_.ms_unconstrained - stats_.ms_rows -
+                    stats_.ms_solve - stats_.ms_integrate;
 }
 
-void DeformableWorld::CollectStaticObjects(std::vector<const btCollisionObject*>& objects) const {
-  objects.clear();
-  const btCollisionObjectArray& all = getCollisionObjectArray();
-  for (int i = 0; i < all.size(); ++i) {
-    const btCollisionObject* object = all[i];
-    if (object->getCollisionShape()->getShapeType() == kDeformableShapeType) continue;
-    if (object->isStaticOrKinematicObject()) objects.push_back(object);
-  }
-}
-
-void DeformableWorld::StepDeformableBodies(double h) {
-  const Vec3 gravity = ToEigen(getGravity());
-  // Attached nodes follow their rigid bodies' current frames.
+void DeformableWorld::UpdateKinematicAttachments() {
   for (auto& entry : bodies_)
     for (const auto& attachment : entry->attachments)
       for (size_t k = 0; k < attachment.nodes.size(); ++k)
         entry->body().SetKinematicTarget(
             attachment.nodes[k],
             ToEigen(attachment.rigid->getWorldTransform() * ToBullet(attachment.local[k])));
+}
+
+namespace {
+// Bounds of the step's sweep of a deformable body: x0 and x0 + h v*, grown by `margin`.
+void CalcSweptBounds(const DeformableBody& body, double h, double margin, Vec3& lo, Vec3& hi) {
+  lo.setConstant(std::numeric_limits<double>::infinity());
+  hi = -lo;
+  const VecX& x0 = body.x0();
+  const VecX& v = body.v_star();
+  for (int i = 0; i < body.num_nodes(); ++i) {
+    const Vec3 p = x0.segment<3>(3 * i);
+    const Vec3 q = p + h * v.segment<3>(3 * i);
+    lo = lo.cwiseMin(p).cwiseMin(q);
+    hi = hi.cwiseMax(p).cwiseMax(q);
+  }
+  lo.array() -= margin;
+  hi.array() += margin;
+}
+
+// True when the boxes [lo, hi] and Bullet's proxy bounds overlap.
+bool Overlaps(const Vec3& lo, const Vec3& hi, const btBroadphaseProxy& proxy) {
+  const Vec3 plo = ToEigen(proxy.m_aabbMin), phi = ToEigen(proxy.m_aabbMax);
+  return (lo.array() <= phi.array()).all() && (plo.array() <= hi.array()).all();
+}
+}  // namespace
+
+void DeformableWorld::BuildIslands(double h, const btContactSolverInfo& info) {
+  const int num_deformables = static_cast<int>(bodies_.size());
+  const btCollisionObjectArray& objects = getCollisionObjectArray();
+  // Dynamic rigid bodies get union-find indices after the deformables.
+  dynamic_.clear();
+  dynamic_index_.assign(objects.size(), -1);
+  for (int i = 0; i < objects.size(); ++i) {
+    btRigidBody* rigid = btRigidBody::upcast(objects[i]);
+    if (rigid == nullptr || rigid->isStaticOrKinematicObject()) continue;
+    if (rigid->getCollisionShape()->getShapeType() == kDeformableShapeType) continue;
+    dynamic_index_[i] = num_deformables + static_cast<int>(dynamic_.size());
+    dynamic_.push_back(rigid);
+  }
+  union_find_.Reset(num_deformables + static_cast<int>(dynamic_.size()));
+  // Deformable-rigid pairs whose bounds overlap (everything else skips the narrow phase).
+  double max_rigid_speed = 0.0;
+  for (btRigidBody* rigid : dynamic_)
+    max_rigid_speed = std::max(max_rigid_speed, static_cast<double>(rigid->getLinearVelocity().length()));
+  for (int d = 0; d < num_deformables; ++d) {
+    Entry& entry = *bodies_[d];
+    entry.partners.clear();
+    Vec3 lo, hi;
+    CalcSweptBounds(entry.body(), h, entry.body().settings().contact_margin + h * max_rigid_speed,
+                    lo, hi);
+    for (int i = 0; i < objects.size(); ++i) {
+      const btCollisionObject* object = objects[i];
+      if (object->getCollisionShape()->getShapeType() == kDeformableShapeType) continue;
+      if (object->hasContactResponse() == false || object->getBroadphaseHandle() == nullptr)
+        continue;
+      if (!Overlaps(lo, hi, *object->getBroadphaseHandle())) continue;
+      if (dynamic_index_[i] >= 0) {
+        union_find_.Unite(d, dynamic_index_[i]);
+        entry.partners.push_back({object, nullptr});  // rigid island body filled in below
+      } else if (object->isStaticOrKinematicObject()) {
+        entry.partners.push_back({object, nullptr});
+      }
+    }
+    for (const auto& attachment : entry.dynamic_attachments)
+      union_find_.Unite(d, dynamic_index_[attachment->rigid()->rigid()->getWorldArrayIndex()]);
+  }
+  // Rigid bodies touching each other (Bullet's manifolds with points) share an island.
+  btDispatcher* dispatcher = getDispatcher();
+  for (int m = 0; m < dispatcher->getNumManifolds(); ++m) {
+    const btPersistentManifold* manifold = dispatcher->getManifoldByIndexInternal(m);
+    if (manifold->getNumContacts() == 0) continue;
+    const int a = dynamic_index_[manifold->getBody0()->getWorldArrayIndex()];
+    const int b = dynamic_index_[manifold->getBody1()->getWorldArrayIndex()];
+    if (a >= 0 && b >= 0) union_find_.Unite(a, b);
+  }
+  // Islands: one per root that holds a deformable (deformables are the lowest indices, so the
+  // root of an island with deformables is its first deformable).
+  island_of_root_.assign(num_deformables, -1);
+  num_islands_ = 0;
+  for (int d = 0; d < num_deformables; ++d) {
+    const int root = union_find_.Find(d);
+    if (island_of_root_[root] < 0) {
+      if (static_cast<int>(islands_.size()) <= num_islands_) islands_.emplace_back();
+      Island& island = islands_[num_islands_];
+      island.bodies.clear();
+      island.sources.clear();
+      if (island.manifolds == nullptr)
+        island.manifolds = std::make_unique<RigidManifoldSource>(next_source_id_++);
+      island.manifolds->Clear();
+      island.first_entry = d;
+      island_of_root_[root] = num_islands_++;
+    }
+    Entry& entry = *bodies_[d];
+    entry.island = island_of_root_[root];
+    islands_[entry.island].bodies.push_back(entry.island_body.get());
+  }
+  // Coupled rigid bodies: start their step before Bullet's solver changes their velocity.
+  coupled_.clear();
+  for (size_t k = 0; k < dynamic_.size(); ++k) {
+    const int root = union_find_.Find(num_deformables + static_cast<int>(k));
+    if (root >= num_deformables) continue;  // a rigid island: Bullet's alone
+    RigidIslandBody* body = FindRigidIslandBody(dynamic_[k]);
+    dynamic_[k]->activate();  // Bullet's sleeping test does not see deformable contacts
+    body->BeginStep(h);
+    coupled_.push_back(body);
+    islands_[island_of_root_[root]].bodies.push_back(body);
+  }
+  for (auto& entry : bodies_)
+    for (ContactPartner& partner : entry->partners) {
+      const int index = dynamic_index_[partner.object->getWorldArrayIndex()];
+      if (index >= 0) partner.rigid = FindRigidIslandBody(dynamic_[index - num_deformables]);
+    }
+  // Manifolds touching a coupled body go into its island's SQP.
+  for (int m = 0; m < dispatcher->getNumManifolds(); ++m) {
+    const btPersistentManifold* manifold = dispatcher->getManifoldByIndexInternal(m);
+    if (manifold->getNumContacts() == 0) continue;
+    int root = -1;
+    const RigidIslandBody* sides[2] = {nullptr, nullptr};
+    const btCollisionObject* objects_ab[2] = {manifold->getBody0(), manifold->getBody1()};
+    for (int s = 0; s < 2; ++s) {
+      const int index = dynamic_index_[objects_ab[s]->getWorldArrayIndex()];
+      if (index < 0) continue;
+      const int r = union_find_.Find(index);
+      if (r >= num_deformables) continue;
+      root = r;
+      sides[s] = FindRigidIslandBody(dynamic_[index - num_deformables]);
+    }
+    if (root >= 0)
+      islands_[island_of_root_[root]].manifolds->AddManifold(*manifold, sides[0], sides[1], info);
+  }
+  // Row sources of each island.
+  for (auto& entry : bodies_) {
+    Island& island = islands_[entry->island];
+    for (auto& source : entry->sources) island.sources.push_back(source.get());
+    if (!entry->partners.empty()) {
+      entry->contacts->set_partners(entry->partners);
+      island.sources.push_back(entry->contacts.get());
+    }
+    for (auto& attachment : entry->dynamic_attachments) island.sources.push_back(attachment.get());
+  }
+  for (int i = 0; i < num_islands_; ++i)
+    if (islands_[i].manifolds->num_points() > 0)
+      islands_[i].sources.push_back(islands_[i].manifolds.get());
+}
+
+void DeformableWorld::AccumulateStats(const StepStats& island_stats) {
+  stats_.ms_rows += island_stats.ms_rows;
+  stats_.ms_solve += island_stats.ms_solve;
+  stats_.rows_strain += island_stats.rows_strain;
+  stats_.rows_energy += island_stats.rows_energy;
+  stats_.rows_contact += island_stats.rows_contact;
+  stats_.rows_rigid_contact += island_stats.rows_rigid_contact;
+  stats_.rows_joint += island_stats.rows_joint;
+  stats_.pgs_sweeps += island_stats.pgs_sweeps;
+  stats_.sqp_iterations = std::max(stats_.sqp_iterations, island_stats.sqp_iterations);
+  stats_.restoration_iterations += island_stats.restoration_iterations;
+  stats_.active_set_solves += island_stats.active_set_solves;
+  stats_.stationarity = std::max(stats_.stationarity, island_stats.stationarity);
+  stats_.violation_before = std::max(stats_.violation_before, island_stats.violation_before);
+  stats_.violation_after = std::max(stats_.violation_after, island_stats.violation_after);
+  stats_.converged = stats_.converged && island_stats.converged;
+}
+
+void DeformableWorld::solveConstraints(btContactSolverInfo& info) {
+  if (bodies_.empty()) {
+    btDiscreteDynamicsWorld::solveConstraints(info);
+    return;
+  }
+  const double h = static_cast<double>(info.m_timeStep);
+  stats_ = StepStats();
+  // Stage 2: unconstrained implicit step of every deformable body.
+  const Vec3 gravity = ToEigen(getGravity());
+  UpdateKinematicAttachments();
   auto t = std::chrono::steady_clock::now();
   for (auto& entry : bodies_) entry->body().BeginStep(h, gravity);
   stats_.ms_unconstrained = MsSince(t);
-  // Limits and contacts with static/kinematic rigid objects: one SQP per constrained body (these
-  // rows couple no bodies).
-  std::vector<const btCollisionObject*> objects;
-  CollectStaticObjects(objects);
-  std::vector<DeformableBody*> island(1);
-  std::vector<ConstraintSource*> sources;
-  for (auto& entry : bodies_) {
-    DeformableBody& body = entry->body();
-    if (!objects.empty() && entry->contacts == nullptr)
-      entry->contacts = std::make_unique<RigidContactSource>(
-          body, next_source_id_++, body.settings().friction, body.settings().contact_margin);
-    if (entry->sources.empty() && objects.empty()) continue;
-    island[0] = &body;
-    sources.clear();
-    for (auto& source : entry->sources) sources.push_back(source.get());
-    if (!objects.empty()) {
-      entry->contacts->set_objects(objects);
-      sources.push_back(entry->contacts.get());
-    }
-    StepStats body_stats;
-    entry->solver.Solve(h, island, sources, solver_settings_, body_stats);
-    stats_.ms_rows += body_stats.ms_rows;
-    stats_.ms_solve += body_stats.ms_solve;
-    stats_.rows_strain += body_stats.rows_strain;
-    stats_.rows_energy += body_stats.rows_energy;
-    stats_.rows_contact += body_stats.rows_contact;
-    stats_.pgs_sweeps += body_stats.pgs_sweeps;
-    stats_.sqp_iterations = std::max(stats_.sqp_iterations, body_stats.sqp_iterations);
-    stats_.restoration_iterations += body_stats.restoration_iterations;
-    stats_.active_set_solves += body_stats.active_set_solves;
-    stats_.stationarity = std::max(stats_.stationarity, body_stats.stationarity);
-    stats_.violation_before = std::max(stats_.violation_before, body_stats.violation_before);
-    stats_.violation_after = std::max(stats_.violation_after, body_stats.violation_after);
-    stats_.converged = stats_.converged && body_stats.converged;
+  // Stage 3: islands; then Bullet's solver for every rigid island (bodies coupled to
+  // deformables are restored and solved again below, with the deformables).
+  t = std::chrono::steady_clock::now();
+  BuildIslands(h, info);
+  stats_.ms_rows += MsSince(t);
+  btDiscreteDynamicsWorld::solveConstraints(info);
+  // Stages 4-6: one SQP per island with rows (no rows: no LCP at all).
+  for (int i = 0; i < num_islands_; ++i) {
+    Island& island = islands_[i];
+    if (island.sources.empty()) continue;
+    StepStats island_stats;
+    bodies_[island.first_entry]->solver.Solve(h, island.bodies, island.sources, solver_settings_,
+                                              island_stats);
+    AccumulateStats(island_stats);
+    stats_.islands++;
   }
+  for (RigidIslandBody* rigid : coupled_) rigid->EndStep();
+  stats_.rigid_bodies_coupled = static_cast<int>(coupled_.size());
+  // Stage 7: x = x0 + h v (Bullet integrates the rigid transforms next).
   t = std::chrono::steady_clock::now();
   for (auto& entry : bodies_) entry->body().EndStep(h);
   stats_.ms_integrate = MsSince(t);

@@ -5,10 +5,16 @@
 #include <BulletDynamics/Dynamics/btDiscreteDynamicsWorld.h>
 
 #include <memory>
+#include <unordered_map>
 #include <vector>
 
 #include "bullet_bridge/deformable_collision_object.h"
+#include "bullet_bridge/node_attachment_source.h"
 #include "bullet_bridge/rigid_contact_source.h"
+#include "bullet_bridge/rigid_island_body.h"
+#include "bullet_bridge/rigid_manifold_source.h"
+#include "constraints/deformable_island_body.h"
+#include "constraints/union_find.h"
 #include "constraints/energy_limit_constraint.h"
 #include "constraints/sqp_solver.h"
 #include "constraints/step_stats.h"
@@ -20,8 +26,13 @@ namespace taut {
 
 // Drop-in replacement for btDiscreteDynamicsWorld. Deformable bodies live in Bullet's broadphase
 // as btCollisionObjects (AABBs refreshed every substep) and are stepped inside stepSimulation's
-// fixed substeps together with the rigid bodies. Without deformable bodies every substep is
-// exactly btDiscreteDynamicsWorld's.
+// fixed substeps together with the rigid bodies. Islands (DESIGN.md "Islands") join each
+// deformable body with the dynamic rigid bodies it touches or is attached to, and with the rigid
+// bodies those touch through Bullet's contact manifolds; every island is one SQP whose QPs hold
+// the limit rows, the deformable contact rows, the node attachments and Bullet's rigid-rigid
+// contacts of the island, solved by one PGS. Rigid islands without deformables go to Bullet's
+// own solver untouched; without deformable bodies every substep is exactly
+// btDiscreteDynamicsWorld's.
 class DeformableWorld : public btDiscreteDynamicsWorld {
  public:
   DeformableWorld(btDispatcher* dispatcher, btBroadphaseInterface* broadphase,
@@ -52,10 +63,10 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   // C = 1 - U_e/U_max).
   // Replaces earlier energy limits of the body; throws InputError for invalid settings.
   EnergyLimitConstraint* SetEnergyLimits(DeformableBody* body, const EnergyLimitSettings& limits);
-  // Pins `nodes` of `body` to `rigid` (a bone driving soft flesh): every substep the nodes are
-  // driven kinematically to their rest offsets in the rigid body's current frame. One-way: the
-  // rigid body feels no reaction (use kinematic or static bodies). Throws InputError for a node
-  // out of range.
+  // Pins `nodes` of `body` to `rigid` at their current offsets in the rigid body's frame (a
+  // bone in soft flesh). A static or kinematic rigid body drives the nodes kinematically; a
+  // dynamic one is coupled both ways by bilateral rows in the island's solve (it feels the
+  // flesh). The rigid body must be in this world. Throws InputError for a node out of range.
   void AttachNodesToRigidBody(DeformableBody* body, const std::vector<int>& nodes,
                               const btRigidBody* rigid);
   // Removes every constraint source (limits) of the body.
@@ -71,31 +82,51 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   const StepStats& last_step_stats() const { return stats_; }
 
  protected:
-  // One fixed substep: deformable step (stages 2-7), then Bullet's rigid step.
+  // One fixed substep; Bullet's sequence calls solveConstraints below between collision
+  // detection and the integration of the rigid transforms.
   void internalSingleStepSimulation(btScalar h) override;
+  // Deformable step (stages 2-7) and islands: unconstrained deformable step, islands, Bullet's
+  // solver for the rigid islands, one SQP per deformable island, x = x0 + h v.
+  void solveConstraints(btContactSolverInfo& info) override;
 
  private:
-  // Unconstrained implicit step of every deformable body, limits and contacts, integration.
-  void StepDeformableBodies(double h);
-  // Static and kinematic rigid objects (contact partners of deformables), into objects.
-  void CollectStaticObjects(std::vector<const btCollisionObject*>& objects) const;
-
   // A body with its Bullet proxy, its constraint sources and its solver (warm starts).
   struct Entry {
     std::unique_ptr<DeformableCollisionObject> object;
-    std::vector<std::unique_ptr<ConstraintSource>> sources;
-    std::unique_ptr<RigidContactSource> contacts;  // made when the world has static objects
-    // Nodes pinned to rigid bodies, with their offsets in the rigid body's frame.
+    std::unique_ptr<DeformableIslandBody> island_body;
+    std::vector<std::unique_ptr<BodyConstraintSource>> sources;  // limits
+    std::unique_ptr<RigidContactSource> contacts;
+    // Nodes pinned to static or kinematic rigid bodies (kinematic targets), with their offsets
+    // in the rigid body's frame.
     struct Attachment {
       const btRigidBody* rigid;
       std::vector<int> nodes;
       std::vector<Vec3> local;
     };
     std::vector<Attachment> attachments;
+    std::vector<std::unique_ptr<NodeAttachmentSource>> dynamic_attachments;
+    std::vector<ContactPartner> partners;  // this step
     SqpSolver solver;
+    int island = -1;  // this step
     DeformableBody& body() { return object->body(); }
     btCollisionObject& collision_object() { return object->collision_object(); }
   };
+  // One island of this step: bodies (deformables first), row sources, Bullet manifolds.
+  struct Island {
+    std::vector<IslandBody*> bodies;
+    std::vector<ConstraintSource*> sources;
+    std::unique_ptr<RigidManifoldSource> manifolds;
+    int first_entry = -1;  // its solver keeps the warm starts
+  };
+  // Drives nodes attached to static/kinematic rigid bodies to their current anchors.
+  void UpdateKinematicAttachments();
+  // Contact partners of every deformable (bounds overlap), union-find islands, coupled rigid
+  // bodies (BeginStep before Bullet's solver touches them) and their manifolds.
+  void BuildIslands(double h, const btContactSolverInfo& info);
+  // The island body of a dynamic rigid body (made on first use).
+  RigidIslandBody* FindRigidIslandBody(btRigidBody* rigid);
+  // Adds the SQP statistics of one island to the substep's.
+  void AccumulateStats(const StepStats& island_stats);
   // The entry of a body; throws InputError when the body is not in this world.
   Entry& FindEntry(const DeformableBody* body);
   // Installs `source` on the body's entry, replacing any earlier source of the same type T.
@@ -103,6 +134,16 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   T* ReplaceSource(DeformableBody* body, std::unique_ptr<T> source);
 
   std::vector<std::unique_ptr<Entry>> bodies_;
+  std::unordered_map<const btCollisionObject*, std::unique_ptr<RigidIslandBody>> rigid_bodies_;
+  // Per-step scratch (kept to avoid allocations): dynamic rigid bodies, their union-find index
+  // by world array index, the coupled ones, islands.
+  std::vector<btRigidBody*> dynamic_;
+  std::vector<int> dynamic_index_;
+  std::vector<RigidIslandBody*> coupled_;
+  std::vector<int> island_of_root_;
+  std::vector<Island> islands_;
+  int num_islands_ = 0;
+  UnionFind union_find_;
   SqpSettings solver_settings_;
   int next_source_id_ = 0;
   btEmptyAlgorithm::CreateFunc empty_algorithm_;

@@ -1,43 +1,53 @@
-// Contacts of a deformable body's boundary nodes with Bullet's static and kinematic rigid
-// objects, as SQP rows: normal C = gap >= 0 and two Coulomb friction rows (MATH.md §5).
+// Contacts of a deformable body's boundary nodes with Bullet rigid objects, as SQP rows: normal
+// C = gap >= 0 and two Coulomb friction rows on the disk (MATH.md §5). Static and kinematic
+// objects are immovable during the step (one-sided rows); dynamic rigid bodies of the island
+// take the reaction (two-sided rows: the node against the body's surface point).
 #pragma once
 
 #include <BulletCollision/CollisionDispatch/btCollisionObject.h>
 
 #include <vector>
 
+#include "bullet_bridge/rigid_island_body.h"
 #include "constraints/constraint_row.h"
 
 namespace taut {
 
-// Rigid objects are treated as immovable during the step (static, or kinematic with the motion
-// Bullet gave them). Two-way coupling with dynamic rigid bodies is not part of this source.
-class RigidContactSource final : public BodyConstraintSource {
+// A rigid object a deformable may touch this step.
+struct ContactPartner {
+  const btCollisionObject* object = nullptr;
+  const RigidIslandBody* rigid = nullptr;  // island body of a dynamic rigid body, else null
+};
+
+class RigidContactSource final : public ConstraintSource {
  public:
   // `friction` is the body's Coulomb coefficient, combined with each object's by the product
   // (Bullet's default combiner); `margin` [m] is how close a node must be to get rows.
   RigidContactSource(const DeformableBody& body, int source_id, double friction, double margin);
 
-  // The rigid objects to test this step (static and kinematic objects of the world).
-  void set_objects(const std::vector<const btCollisionObject*>& objects) { objects_ = objects; }
+  const DeformableBody& body() const { return body_; }
+  // The partners to test this step (those whose bounds overlap the body's).
+  void set_partners(const std::vector<ContactPartner>& partners) { partners_ = partners; }
+  const std::vector<ContactPartner>& partners() const { return partners_; }
+  // Immovable partners only (convenience for static scenes and tests).
+  void set_objects(const std::vector<const btCollisionObject*>& objects);
 
-  const DeformableBody& body() const override { return body_; }
-  int AppendRows(const VecX& x, int body_index, std::vector<ConstraintRow>& rows) override;
-  double CalcMaxViolation(const VecX& x) const override;
-  double CalcViolationSum(const VecX& x) const override;
-  // Largest penetration max(0, -gap) at x [m].
-  double CalcMaxPenetration(const VecX& x) const { return CalcMaxViolation(x); }
+  int AppendIslandRows(const IslandIterate& iterate, std::vector<ConstraintRow>& rows) override;
+  double CalcIslandMaxViolation(const IslandIterate& iterate) const override;
+  double CalcIslandViolationSum(const IslandIterate& iterate) const override;
 
  private:
-  // Smallest gap of node i over the objects (+inf when none is within the margin).
-  double CalcNodeGap(const VecX& x, int node) const;
+  // Transform of partner o at the iterate (dynamic partners move with their velocity).
+  btTransform CalcPartnerTransform(const IslandIterate& iterate, size_t o) const;
+  // Smallest gap of node i over the partners at the iterate (+inf when none is within the margin).
+  double CalcNodeGap(const IslandIterate& iterate, const VecX& x, int node) const;
 
   const DeformableBody& body_;
   std::uint64_t key_prefix_;
   double friction_;
   double margin_;
   std::vector<int> surface_nodes_;  // free boundary nodes
-  std::vector<const btCollisionObject*> objects_;
+  std::vector<ContactPartner> partners_;
 };
 
 }  // namespace taut

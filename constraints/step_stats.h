@@ -29,7 +29,6 @@ struct StepStats {
 
   int islands = 0;                // islands solved by the SQP (with at least one row source)
   int rigid_bodies_coupled = 0;   // dynamic rigid bodies solved inside deformable islands
-  double max_penetration = 0.0;   // deepest deformable contact penetration at the end [m]
 
   int rows_total() const {
     return rows_strain + rows_energy + rows_contact + rows_rigid_contact + rows_joint;

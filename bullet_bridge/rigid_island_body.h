@@ -1,0 +1,51 @@
+// A dynamic Bullet rigid body as a body of a deformable island (two-way coupling, DESIGN.md
+// "Islands"): velocity blocks (v, omega), A = diag(m I, I_world).
+#pragma once
+
+#include <BulletDynamics/Dynamics/btRigidBody.h>
+
+#include "constraints/island_body.h"
+
+namespace taut {
+
+// Block 0 is the linear velocity of the centre of mass, block 1 the angular velocity (world
+// frame). Between BeginStep and EndStep the body's Bullet state is the step start; v* is Bullet's
+// unconstrained velocity (external force and torque impulses, implicit gyroscopic term), and the
+// solved v is written back at EndStep, before Bullet integrates the transform.
+class RigidIslandBody final : public IslandBody {
+ public:
+  explicit RigidIslandBody(btRigidBody* body);
+
+  // Saves the step-start transform and velocity and computes v* for a step of length h:
+  //   v* = v + h F / m,  omega* = omega + h I^-1 tau (+ Bullet's implicit gyroscopic impulse).
+  void BeginStep(double h);
+  // Restores the step-start transform (undoing any pass of Bullet's own solver over the body)
+  // and writes the solved velocity to the body.
+  void EndStep();
+
+  int num_blocks() const override { return 2; }
+  const VecX& v_star() const override { return v_star_; }
+  const VecX& v() const override { return v_; }
+  void set_v(const VecX& v) override { v_ = v; }
+  // [dv; dw] = [lin_factor / m * f; I_world^-1 (ang_factor * tau)] per column.
+  void SolveSystemColumns(Eigen::Ref<MatX> columns) const override;
+  void ApplySystemMatrix(const VecX& v, VecX& out) const override;
+  bool is_free_block(int /*i*/) const override { return true; }
+  void CalcPositions(double /*h*/, const VecX& /*v*/, VecX& x) const override { x.resize(0); }
+
+  // Transform after a step h at velocity v = [lin; ang] (Bullet's exponential-map integrator).
+  btTransform PredictTransform(double h, const VecX& v) const;
+  // Velocity of the material point p (world) at velocity v: lin + ang x (p - com).
+  static Vec3 CalcPointVelocity(const VecX& v, const Vec3& p, const Vec3& com);
+  btRigidBody* rigid() const { return body_; }
+  const btTransform& start_transform() const { return start_; }
+
+ private:
+  btRigidBody* body_;
+  btTransform start_;
+  VecX v_star_, v_;
+  Mat3 inverse_inertia_;  // world frame, step start
+  Mat3 inertia_;          // its pseudo-inverse
+};
+
+}  // namespace taut
