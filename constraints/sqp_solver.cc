@@ -34,13 +34,19 @@ void SqpSolver::CalcPositions(double h, const std::vector<IslandBody*>& bodies,
 }
 
 double SqpSolver::CollectRows(double h, const std::vector<IslandBody*>& bodies,
-                              const std::vector<ConstraintSource*>& sources) {
+                              const std::vector<ConstraintSource*>& sources,
+                              const SqpSettings& settings) {
   rows_.clear();
   CalcPositions(h, bodies, v_k_);
   const IslandIterate iterate(h, bodies, v_k_, x_);
   for (ConstraintSource* source : sources) source->AppendIslandRows(iterate, rows_);
+  // Limit rows have C in fractions of the limit, contact and joint rows in metres.
+  const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
   double violation = 0.0;
-  for (const ConstraintRow& row : rows_) violation = std::max(violation, row.violation());
+  for (const ConstraintRow& row : rows_) {
+    const bool distance = row.type != RowType::kStrainLimit && row.type != RowType::kEnergyLimit;
+    violation = std::max(violation, row.violation() * (distance ? distance_scale : 1.0));
+  }
   body_rows_.resize(bodies.size());
   for (auto& rows : body_rows_) rows.clear();
   for (size_t c = 0; c < rows_.size(); ++c) {
@@ -169,7 +175,7 @@ void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
   bool restoring = false;
   for (int k = 0;; ++k) {
     auto t_rows = std::chrono::steady_clock::now();
-    const double violation = CollectRows(h, bodies, sources);
+    const double violation = CollectRows(h, bodies, sources, settings);
     stats.ms_rows += MsSince(t_rows);
     if (k == 0) stats.violation_before = violation;
     stats.violation_after = violation;

@@ -24,6 +24,8 @@ inline PgsSettings DefaultPgs() {
 struct SqpSettings {
   int max_iterations = 10;           // SQP iterations per step (cap), before restoration
   double violation_tolerance = 1e-3; // stop when max(0, -C) <= this (C is a fraction of the limit)
+  double contact_tolerance = 1e-5;   // [m] the same for contact and joint rows, whose C is a
+                                     // distance (rigid contacts: h times a velocity error)
   double stationarity_tolerance = 1e-2;  // ... and ||A(v - v*) - J^T lambda|| / ||J^T lambda||
   int max_restoration_iterations = 10;  // push-only iterations after the cap while infeasible
   int max_line_search_halvings = 8;  // merit backtracking: alpha = 1, 1/2, ...
@@ -56,9 +58,10 @@ class SqpSolver {
  private:
   // Positions x_b of every body at velocities v.
   void CalcPositions(double h, const std::vector<IslandBody*>& bodies, const std::vector<VecX>& v);
-  // Rows of every source at the current iterate; returns the largest row violation.
+  // Rows of every source at the current iterate; returns the largest row violation in units of
+  // violation_tolerance (contact and joint rows scaled by violation / contact tolerance).
   double CollectRows(double h, const std::vector<IslandBody*>& bodies,
-                     const std::vector<ConstraintSource*>& sources);
+                     const std::vector<ConstraintSource*>& sources, const SqpSettings& settings);
   // Y_b = A_b^-1 J_b^T per body and W = J Y.
   void BuildDelassus(const std::vector<IslandBody*>& bodies);
   // Sum of violations of every source at velocities v (per body).

@@ -22,8 +22,10 @@ struct StepStats {
   int active_set_solves = 0;      // QPs refined by a direct active-set solve
   int sqp_iterations = 0;         // including restoration iterations
   int restoration_iterations = 0; // push-only iterations after the SQP cap
-  double violation_before = 0.0;  // max(0, -C) at the unconstrained prediction x*
-  double violation_after = 0.0;   // max(0, -C) at the end of the step
+  // Violations in units of the limit rows' C (fraction of the limit): max(0, -C) of limit rows,
+  // and of contact/joint rows (C in m) times violation_tolerance / contact_tolerance.
+  double violation_before = 0.0;  // at the unconstrained prediction x*
+  double violation_after = 0.0;   // at the end of the step
   double stationarity = 0.0;      // ||A(v - v*) - J^T lambda|| / ||J^T lambda|| at the end
   bool converged = true;          // violation within tolerance at the end (false: caps reached)
 

@@ -15,6 +15,11 @@ struct BulletWorldHolder {
   ~BulletWorldHolder();
   // Adds a static ground plane z = 0 with the given Coulomb friction; the holder owns it.
   btRigidBody* AddStaticGround(double friction = 1.0);
+  // Adds a rigid body of `shape` (the holder owns it) with its centre of mass at `position`:
+  // dynamic when mass > 0 (inertia from the shape), static when mass = 0.
+  btRigidBody* AddRigidBody(std::unique_ptr<btCollisionShape> shape, double mass,
+                            const btVector3& position, double friction = 0.5,
+                            double restitution = 0.0);
   btDefaultCollisionConfiguration configuration;
   btCollisionDispatcher dispatcher{&configuration};
   btDbvtBroadphase broadphase;
