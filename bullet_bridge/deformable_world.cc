@@ -195,6 +195,11 @@ bool Overlaps(const Vec3& lo, const Vec3& hi, const btBroadphaseProxy& proxy) {
 }
 }  // namespace
 
+int DeformableWorld::DynamicIndex(const btCollisionObject& object) const {
+  const int i = object.getWorldArrayIndex();
+  return i >= 0 && i < static_cast<int>(dynamic_index_.size()) ? dynamic_index_[i] : -1;
+}
+
 void DeformableWorld::BuildIslands(double h, const btContactSolverInfo& info) {
   const int num_deformables = static_cast<int>(bodies_.size());
   const btCollisionObjectArray& objects = getCollisionObjectArray();
@@ -233,15 +238,24 @@ void DeformableWorld::BuildIslands(double h, const btContactSolverInfo& info) {
       }
     }
     for (const auto& attachment : entry.dynamic_attachments)
-      union_find_.Unite(d, dynamic_index_[attachment->rigid()->rigid()->getWorldArrayIndex()]);
+      if (DynamicIndex(*attachment->rigid()->rigid()) >= 0)
+        union_find_.Unite(d, DynamicIndex(*attachment->rigid()->rigid()));
   }
   // Rigid bodies touching each other (Bullet's manifolds with points) share an island.
   btDispatcher* dispatcher = getDispatcher();
   for (int m = 0; m < dispatcher->getNumManifolds(); ++m) {
     const btPersistentManifold* manifold = dispatcher->getManifoldByIndexInternal(m);
     if (manifold->getNumContacts() == 0) continue;
-    const int a = dynamic_index_[manifold->getBody0()->getWorldArrayIndex()];
-    const int b = dynamic_index_[manifold->getBody1()->getWorldArrayIndex()];
+    const int a = DynamicIndex(*manifold->getBody0());
+    const int b = DynamicIndex(*manifold->getBody1());
+    if (a >= 0 && b >= 0) union_find_.Unite(a, b);
+  }
+  // So do rigid bodies joined by Bullet joints.
+  for (int j = 0; j < getNumConstraints(); ++j) {
+    const btTypedConstraint* joint = getConstraint(j);
+    if (!joint->isEnabled()) continue;
+    const int a = DynamicIndex(joint->getRigidBodyA());
+    const int b = DynamicIndex(joint->getRigidBodyB());
     if (a >= 0 && b >= 0) union_find_.Unite(a, b);
   }
   // Islands: one per root that holds a deformable (deformables are the lowest indices, so the
@@ -257,7 +271,9 @@ void DeformableWorld::BuildIslands(double h, const btContactSolverInfo& info) {
       island.sources.clear();
       if (island.manifolds == nullptr)
         island.manifolds = std::make_unique<RigidManifoldSource>(next_source_id_++);
+      if (island.joints == nullptr) island.joints = std::make_unique<JointSource>(next_source_id_++);
       island.manifolds->Clear();
+      island.joints->Clear();
       island.first_entry = d;
       island_of_root_[root] = num_islands_++;
     }
@@ -278,7 +294,7 @@ void DeformableWorld::BuildIslands(double h, const btContactSolverInfo& info) {
   }
   for (auto& entry : bodies_)
     for (ContactPartner& partner : entry->partners) {
-      const int index = dynamic_index_[partner.object->getWorldArrayIndex()];
+      const int index = DynamicIndex(*partner.object);
       if (index >= 0) partner.rigid = FindRigidIslandBody(dynamic_[index - num_deformables]);
     }
   // Manifolds touching a coupled body go into its island's SQP.
@@ -289,7 +305,7 @@ void DeformableWorld::BuildIslands(double h, const btContactSolverInfo& info) {
     const RigidIslandBody* sides[2] = {nullptr, nullptr};
     const btCollisionObject* objects_ab[2] = {manifold->getBody0(), manifold->getBody1()};
     for (int s = 0; s < 2; ++s) {
-      const int index = dynamic_index_[objects_ab[s]->getWorldArrayIndex()];
+      const int index = DynamicIndex(*objects_ab[s]);
       if (index < 0) continue;
       const int r = union_find_.Find(index);
       if (r >= num_deformables) continue;
@@ -298,6 +314,22 @@ void DeformableWorld::BuildIslands(double h, const btContactSolverInfo& info) {
     }
     if (root >= 0)
       islands_[island_of_root_[root]].manifolds->AddManifold(*manifold, sides[0], sides[1], info);
+  }
+  // Joints touching a coupled body too.
+  for (int j = 0; j < getNumConstraints(); ++j) {
+    btTypedConstraint* joint = getConstraint(j);
+    const btRigidBody* bodies[2] = {&joint->getRigidBodyA(), &joint->getRigidBodyB()};
+    const RigidIslandBody* sides[2] = {nullptr, nullptr};
+    int root = -1;
+    for (int s = 0; s < 2; ++s) {
+      const int index = DynamicIndex(*bodies[s]);
+      if (index < 0) continue;
+      const int r = union_find_.Find(index);
+      if (r >= num_deformables) continue;
+      root = r;
+      sides[s] = FindRigidIslandBody(dynamic_[index - num_deformables]);
+    }
+    if (root >= 0) islands_[island_of_root_[root]].joints->AddJoint(*joint, sides[0], sides[1], info);
   }
   // Row sources of each island.
   for (auto& entry : bodies_) {
@@ -309,9 +341,11 @@ void DeformableWorld::BuildIslands(double h, const btContactSolverInfo& info) {
     }
     for (auto& attachment : entry->dynamic_attachments) island.sources.push_back(attachment.get());
   }
-  for (int i = 0; i < num_islands_; ++i)
+  for (int i = 0; i < num_islands_; ++i) {
     if (islands_[i].manifolds->num_points() > 0)
       islands_[i].sources.push_back(islands_[i].manifolds.get());
+    if (islands_[i].joints->num_rows() > 0) islands_[i].sources.push_back(islands_[i].joints.get());
+  }
 }
 
 void DeformableWorld::AccumulateStats(const StepStats& island_stats) {

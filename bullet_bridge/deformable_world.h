@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "bullet_bridge/deformable_collision_object.h"
+#include "bullet_bridge/joint_source.h"
 #include "bullet_bridge/node_attachment_source.h"
 #include "bullet_bridge/rigid_contact_source.h"
 #include "bullet_bridge/rigid_island_body.h"
@@ -116,6 +117,7 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
     std::vector<IslandBody*> bodies;
     std::vector<ConstraintSource*> sources;
     std::unique_ptr<RigidManifoldSource> manifolds;
+    std::unique_ptr<JointSource> joints;
     int first_entry = -1;  // its solver keeps the warm starts
   };
   // Drives nodes attached to static/kinematic rigid bodies to their current anchors.
@@ -123,6 +125,8 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   // Contact partners of every deformable (bounds overlap), union-find islands, coupled rigid
   // bodies (BeginStep before Bullet's solver touches them) and their manifolds.
   void BuildIslands(double h, const btContactSolverInfo& info);
+  // Union-find index of a collision object: >= 0 for dynamic rigid bodies, else -1.
+  int DynamicIndex(const btCollisionObject& object) const;
   // The island body of a dynamic rigid body (made on first use).
   RigidIslandBody* FindRigidIslandBody(btRigidBody* rigid);
   // Adds the SQP statistics of one island to the substep's.

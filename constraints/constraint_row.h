@@ -5,6 +5,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "constraints/island_body.h"
@@ -35,7 +36,9 @@ struct ConstraintRow {
   int body = -1;          // index of side A's body in the island
   int num_nodes = 0;
   RowType type = RowType::kStrainLimit;
-  bool bilateral = false;  // C = 0 with a free multiplier (joints, attachments)
+  bool bilateral = false;  // C = 0 with lo <= lambda <= hi (joints, attachments)
+  double lo = -std::numeric_limits<double>::infinity();  // bilateral rows: multiplier bounds
+  double hi = std::numeric_limits<double>::infinity();   // (finite: motors, friction joints)
   // Friction rows (contact tangents): 1 or 2 = how many rows back the contact's normal row is;
   // 0 for unilateral rows. A friction row targets J v = 0 within the Coulomb disk of radius
   // mu lambda_n; its C is unused.
@@ -54,10 +57,12 @@ struct ConstraintRow {
     for (int n = 0; n < num_nodes; ++n) f(body, nodes[n], J[n]);
     for (int n = 0; n < num_nodes2; ++n) f(body2, nodes2[n], J2[n]);
   }
-  // Violation of the row at its C: max(0, -C) (bilateral |C|; friction rows 0).
+  // Violation of the row at its C: max(0, -C); bilateral |C| (0 when a bound is finite: such a
+  // row may rightly stay unsatisfied at its bound); friction rows 0.
   double violation() const {
     if (friction_of > 0) return 0.0;
-    return bilateral ? std::abs(C) : std::max(0.0, -C);
+    if (!bilateral) return std::max(0.0, -C);
+    return std::isinf(lo) && std::isinf(hi) ? std::abs(C) : 0.0;
   }
 };
 

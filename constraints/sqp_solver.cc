@@ -118,7 +118,7 @@ void SqpSolver::BuildPgsRows() {
   pgs_rows_.assign(rows_.size(), MakeUnilateralRow());
   for (size_t c = 0; c < rows_.size(); ++c) {
     const ConstraintRow& row = rows_[c];
-    if (row.bilateral) pgs_rows_[c] = MakeBilateralRow();
+    if (row.bilateral) pgs_rows_[c] = MakeBilateralRow(row.lo, row.hi);
     if (row.friction_of == 0) continue;
     PgsRow& p = pgs_rows_[c];
     p.kind = RowKind::kFriction;
