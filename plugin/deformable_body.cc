@@ -1,8 +1,19 @@
 #include "plugin/deformable_body.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace taut {
+namespace {
+
+// Index of the first node whose 3 entries of the 3N vector v are not all finite; -1 if none.
+int FindNonFiniteNode(const VecX& v) {
+  for (Eigen::Index i = 0; 3 * i < v.size(); ++i)
+    if (!v.segment<3>(3 * i).allFinite()) return static_cast<int>(i);
+  return -1;
+}
+
+}  // namespace
 
 DeformableBody::DeformableBody(std::unique_ptr<ElementModel> model,
                                const DeformableBodySettings& settings)
@@ -84,15 +95,20 @@ void DeformableBody::AddNodeForce(int node, const Vec3& force) {
 }
 
 void DeformableBody::BeginStep(double h, const Vec3& gravity) {
+  TAUT_DEMAND(std::isfinite(h) && h > 0.0, "body '", name(),
+              "': time step must be finite and > 0 s, got ", h);
+  TAUT_DEMAND(gravity.allFinite(), "body '", name(), "': gravity must be finite, got (",
+              gravity.transpose(), ")");
   if (kinds_changed_) {
     system_.Build(*model_, kinds_);
     kinds_changed_ = false;
   }
   x0_ = x_;
   v0_ = v_;
-  // Forces at x0: elastic (updates rotations) + gravity + external.
+  // Forces at x0: external + elastic (updates rotations), checked, then + gravity.
   force_ = external_;
   model_->UpdateRotationsAndAddForces(x0_, force_);
+  CheckForces();
   for (int i = 0; i < num_nodes(); ++i) force_.segment<3>(3 * i) += mass_[i] * gravity;
   // Prescribed velocities: fixed nodes 0, kinematic nodes reach their target at the step end.
   kinematic_v_.setZero();
@@ -103,7 +119,12 @@ void DeformableBody::BeginStep(double h, const Vec3& gravity) {
   const double c_M = 1.0 + h * settings_.mass_damping;
   const double c_K = h * settings_.stiffness_damping + h * h;
   system_.Assemble(*model_, mass_, c_M, c_K);
-  system_.Factor(name());
+  try {
+    system_.Factor(name());
+  } catch (const SimulationError&) {
+    external_.setZero();  // x, v are still the step start's
+    throw;
+  }
   for (int i = 0; i < num_nodes(); ++i)
     v_star_.segment<3>(3 * i) = mass_[i] * v0_.segment<3>(3 * i) + h * force_.segment<3>(3 * i);
   scratch_.setZero();
@@ -112,6 +133,7 @@ void DeformableBody::BeginStep(double h, const Vec3& gravity) {
   system_.Solve(v_star_);
   v_star_ += kinematic_v_;
   v_ = v_star_;
+  CheckVelocities("unconstrained solve");
   external_.setZero();
 }
 
@@ -120,20 +142,74 @@ void DeformableBody::SolveSystem(Eigen::Ref<VecX> rhs) const { system_.Solve(rhs
 void DeformableBody::SolveSystemColumns(Eigen::Ref<MatX> rhs) const { system_.SolveColumns(rhs); }
 
 void DeformableBody::EndStep(double h) {
-  if (!v_.allFinite()) {
-    int node = 0;
-    while (node < num_nodes() && v_.segment<3>(3 * node).allFinite()) ++node;
-    x_ = x0_;
-    v_ = v0_;
-    throw SimulationError(internal::Concat("body '", name(), "': non-finite velocity at node ",
-                                           node, " (stage: integrate); state kept at step start"));
-  }
+  CheckVelocities("end of step");
   x_ = x0_ + h * v_;
+  if (!x_.allFinite())
+    FailStep(internal::Concat("non-finite position x0 + h v at node ", FindNonFiniteNode(x_)),
+             "end of step");
+}
+
+void DeformableBody::CheckForces() {
+  if (force_.allFinite()) return;
+  const int node = FindNonFiniteNode(force_);
+  if (!external_.segment<3>(3 * node).allFinite())
+    FailStep(internal::Concat("external force on node ", node,
+                              " is not finite (the AddNodeForce calls of this step overflow)"),
+             "force assembly");
+  // One element with a non-finite force makes all of its nodes non-finite: name the first such
+  // element, else the first element at the node.
+  const int k = model_->nodes_per_element();
+  auto bad = [this](int n) { return !force_.segment<3>(3 * n).allFinite(); };
+  int element = -1;
+  for (int e = 0; e < model_->num_elements() && element < 0; ++e) {
+    const int* nodes = model_->element_nodes(e);
+    if (std::all_of(nodes, nodes + k, bad)) element = e;
+  }
+  for (int e = 0; e < model_->num_elements() && element < 0; ++e) {
+    const int* nodes = model_->element_nodes(e);
+    if (std::find(nodes, nodes + k, node) != nodes + k) element = e;
+  }
+  std::string nodes;
+  for (int a = 0; a < k && element >= 0; ++a)
+    nodes += internal::Concat(a ? " " : "", model_->element_nodes(element)[a]);
+  FailStep(internal::Concat("elastic force of element ", element, " (nodes ", nodes,
+                            ") is not finite at the step-start positions"),
+           "force assembly");
+}
+
+void DeformableBody::CheckVelocities(const char* stage) {
+  const int bad = FindNonFiniteNode(v_);
+  if (bad >= 0) FailStep(internal::Concat("non-finite velocity at node ", bad), stage);
+  // Kinematic nodes move as prescribed; only free nodes can explode.
+  const double max_speed_sq = settings_.max_speed * settings_.max_speed;
+  int fastest = -1;
+  double fastest_sq = max_speed_sq;
+  for (int i = 0; i < num_nodes(); ++i) {
+    const double speed_sq = v_.segment<3>(3 * i).squaredNorm();
+    if (kinds_[i] == NodeKind::kFree && speed_sq > fastest_sq) {
+      fastest = i;
+      fastest_sq = speed_sq;
+    }
+  }
+  if (fastest >= 0)
+    FailStep(internal::Concat("node ", fastest, " moves at ",
+                              v_.segment<3>(3 * fastest).stableNorm(), " m/s, above max_speed = ",
+                              settings_.max_speed, " m/s (the step is exploding)"),
+             stage);
+}
+
+void DeformableBody::FailStep(const std::string& what, const char* stage) {
+  x_ = x0_;
+  v_ = v0_;
+  external_.setZero();
+  throw SimulationError(internal::Concat("body '", name(), "': ", what, " (stage: ", stage,
+                                         "); state kept at step start"));
 }
 
 double DeformableBody::CalcKineticEnergy() const {
   double energy = 0.0;
-  for (int i = 0; i < num_nodes(); ++i) energy += 0.5 * mass_[i] * v_.segment<3>(3 * i).squaredNorm();
+  for (int i = 0; i < num_nodes(); ++i)
+    energy += 0.5 * mass_[i] * v_.segment<3>(3 * i).squaredNorm();
   return energy;
 }
 

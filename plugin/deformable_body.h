@@ -18,6 +18,11 @@ namespace taut {
 //               D = alpha M + beta K), factor A, v* = A^-1 b, set v = v*;
 //   (constraints change v by A^-1 J^T lambda, using SolveSystem);
 //   EndStep:    x = x0 + h v.
+// Stage-boundary guards (after force assembly, after the unconstrained solve, at EndStep) throw
+// SimulationError naming the body, the element or node and the stage when a force or velocity is
+// not finite or a free node is faster than settings.max_speed. Before throwing they restore x and
+// v to the step start and drop the step's external forces, so the body can be inspected or
+// stepped again.
 class DeformableBody {
  public:
   DeformableBody(std::unique_ptr<ElementModel> model, const DeformableBodySettings& settings);
@@ -54,6 +59,8 @@ class DeformableBody {
   void AddNodeForce(int node, const Vec3& force);
 
   // Stage 2 of the world step: assemble, factor and solve the unconstrained velocity v*.
+  // Throws InputError when h is not finite and > 0 or gravity is not finite, SimulationError
+  // (state kept at the step start) on a non-finite force, a singular system or an exploding v*.
   void BeginStep(double h, const Vec3& gravity);
   // rhs <- A^-1 rhs on free DOFs, zero on fixed/kinematic DOFs (rhs is 3N).
   void SolveSystem(Eigen::Ref<VecX> rhs) const;
@@ -61,7 +68,8 @@ class DeformableBody {
   void SolveSystemColumns(Eigen::Ref<MatX> rhs) const;
   // out = A v with this step's system matrix (free DOFs; 0 on fixed/kinematic DOFs).
   void ApplySystemMatrix(const VecX& v, VecX& out) const { system_.Multiply(v, out); }
-  // Stage 7: x = x0 + h v. Throws SimulationError (keeping the step-start state) on NaN/Inf.
+  // Stage 7: x = x0 + h v. Throws SimulationError (keeping the step-start state) on NaN/Inf in
+  // v or x, or a free node faster than settings.max_speed.
   void EndStep(double h);
 
   // Elastic energy at the current x [J].
@@ -72,15 +80,25 @@ class DeformableBody {
   void CalcBounds(Vec3& lo, Vec3& hi) const;
 
  private:
+  // Throws InputError unless node is in [0, num_nodes()).
   void CheckNode(int node, const char* what) const;
+  // Force-assembly guard: names the node whose external force, or else the element whose elastic
+  // force, is not finite.
+  void CheckForces();
+  // Velocity guard at `stage`: names the first node with a non-finite velocity, else the fastest
+  // free node when it is faster than settings.max_speed.
+  void CheckVelocities(const char* stage);
+  // Restores x, v to the step start, drops the external forces and throws SimulationError
+  // "body '<name>': <what> (stage: <stage>); state kept at step start".
+  [[noreturn]] void FailStep(const std::string& what, const char* stage);
 
   std::unique_ptr<ElementModel> model_;
   DeformableBodySettings settings_;
   VecX x_, v_, x0_, v0_, v_star_, mass_;
-  VecX force_;          // elastic + external + gravity at x0 (3N)
-  VecX external_;       // user forces for the next step (3N)
-  VecX kinematic_v_;    // prescribed velocities of kinematic nodes (3N, zero elsewhere)
-  VecX scratch_;        // 3N
+  VecX force_;        // elastic + external + gravity at x0 (3N)
+  VecX external_;     // user forces for the next step (3N)
+  VecX kinematic_v_;  // prescribed velocities of kinematic nodes (3N, zero elsewhere)
+  VecX scratch_;      // 3N
   std::vector<NodeKind> kinds_;
   std::vector<Vec3> kinematic_targets_;
   ImplicitSystem system_;

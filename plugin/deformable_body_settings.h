@@ -9,12 +9,15 @@ namespace taut {
 
 // Material, damping and identity of one deformable body.
 struct DeformableBodySettings {
-  std::string name = "body";  // used in error messages and reports
-  Material material;          // E, nu, rho (validated: E > 0, nu in (-1, 0.5), rho > 0)
+  std::string name = "body";       // used in error messages and reports
+  Material material;               // E, nu, rho (validated: E > 0, nu in (-1, 0.5), rho > 0)
   double mass_damping = 0.0;       // Rayleigh alpha [1/s], >= 0: damping force -alpha M v
   double stiffness_damping = 0.0;  // Rayleigh beta [s], >= 0: damping force -beta K v
-  double friction = 0.5;        // Coulomb coefficient >= 0, times the rigid object's friction
-  double contact_margin = 0.01;  // [m] > 0: nodes closer than this to a rigid shape get rows
+  double friction = 0.5;           // Coulomb coefficient >= 0, times the rigid object's friction
+  double contact_margin = 0.01;    // [m] > 0: nodes closer than this to a rigid shape get rows
+  // [m/s] > 0 (+inf disables): a free node faster than this after the unconstrained solve or at
+  // the end of a step counts as an explosion; the step throws SimulationError. Default 1e3 m/s.
+  double max_speed = 1e3;
   // Throws InputError naming the body and the quantity when out of range.
   void Validate() const;
 };

@@ -23,6 +23,8 @@ PACKAGES=(
   libtinyobjloader-dev
   libstb-dev
   gnuplot-nox
+  clang
+  libclang-rt-dev
 )
 
 cd "$(dirname "${BASH_SOURCE[0]}")/.."

@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # Builds and runs every check: (1) Release build + ctest, (2) install into build/stage and build
-# and run tests/consumer against the installed package, (3) Debug ASan/UBSan build + ctest.
+# and run tests/consumer against the installed package, (3) Debug ASan/UBSan build + ctest,
+# (4) a 20 s libFuzzer run of every mesh reader.
 #   scripts/run_tests.sh [--quick | --sanitize-only]
-#     --quick          stages 1-2 only (skip the sanitizer build)
-#     --sanitize-only  stage 3 only
+#     --quick          stages 1-2 only (skip the sanitizer build and the fuzz smoke)
+#     --sanitize-only  stages 3-4 only
 # Ends with one line giving each stage's wall time; exits non-zero on any failure.
 set -euo pipefail
 # shellcheck source-path=SCRIPTDIR source=build.sh
@@ -65,6 +66,11 @@ stage_consumer() {
   build/consumer/taut_consumer
 }
 
+# Stage 4: libFuzzer smoke of every mesh reader (20 s each, clang, ASan + UBSan).
+stage_fuzz() {
+  bash scripts/run_fuzz.sh 20
+}
+
 # Stage 3: Debug build with AddressSanitizer + UBSan and its tests.
 stage_asan() {
   taut_build_asan
@@ -116,4 +122,5 @@ current=""
 if ((run_release)); then run_stage release; fi
 if ((run_consumer)); then run_stage consumer; fi
 if ((run_asan)); then run_stage asan; fi
+if ((run_asan)); then run_stage fuzz; fi
 taut_stage "All stages passed"

@@ -198,5 +198,39 @@ TEST(RigidCouplingTest, RigidStackOnASoftBodyHoldsThroughTheIslandsRigidContacts
             MaxZ(*pad) - 0.01);  // the bottom box sits on the pad, not in it
 }
 
+// Highest bounce of a ball dropped from 0.5 m onto a heavy rigid slab lying on a soft pad, with
+// the given restitution (ball and slab; Bullet combines them by the product).
+double CalcBounceOnSlab(double restitution) {
+  BulletWorldHolder holder;
+  holder.AddStaticGround(1.0);
+  holder.world.AddTetBody(MakeBoxTetMesh(Vec3(0.4, 0.4, 0.1), 4, 4, 1, Vec3(-0.2, -0.2, 0.0)),
+                          SoftSettings(1e6, 5.0));
+  btRigidBody* slab = holder.AddRigidBody(std::make_unique<btBoxShape>(btVector3(0.15, 0.15, 0.02)),
+                                          50.0, btVector3(0, 0, 0.121), 0.5, 1.0);
+  btRigidBody* ball = holder.AddRigidBody(std::make_unique<btSphereShape>(0.03), 0.1,
+                                          btVector3(0, 0, 0.141 + 0.5 + 0.03), 0.5, restitution);
+  bool hit = false;
+  double bounce = 0.0;
+  for (int i = 0; i < 360; ++i) {
+    holder.world.stepSimulation(kStep, 1, kStep);
+    const double bottom = static_cast<double>(ball->getWorldTransform().getOrigin().z()) - 0.03;
+    const double slab_top = static_cast<double>(slab->getWorldTransform().getOrigin().z()) + 0.02;
+    if (bottom - slab_top < 0.01) hit = true;
+    if (hit) bounce = std::max(bounce, bottom - slab_top);
+    if (hit && holder.world.last_step_stats().rows_rigid_contact > 0)
+      EXPECT_EQ(holder.world.last_step_stats().rigid_bodies_coupled, 2) << "step " << i;
+  }
+  return bounce;
+}
+
+TEST(RigidCouplingTest, RestitutionOfRigidContactsInsideTheIslandIsHonoured) {
+  const double elastic = CalcBounceOnSlab(0.9), inelastic = CalcBounceOnSlab(0.0);
+  std::printf("ball on a slab on a soft pad, dropped 0.5 m: bounce %.4f m (e = 0.9, ideal %.4f), "
+              "%.4f m (e = 0)\n",
+              elastic, 0.81 * 0.5, inelastic);
+  EXPECT_NEAR(elastic, 0.81 * 0.5, 0.05 * 0.81 * 0.5);  // e^2 h: the 50 kg slab barely moves
+  EXPECT_LT(inelastic, 0.01);
+}
+
 }  // namespace
 }  // namespace taut
