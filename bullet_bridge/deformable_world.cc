@@ -373,11 +373,28 @@ void DeformableWorld::solveConstraints(btContactSolverInfo& info) {
   }
   const double h = static_cast<double>(info.m_timeStep);
   stats_ = StepStats();
+  coupled_.clear();
+  int begun = 0;
+  try {
+    StepDeformables(h, info, begun);
+  } catch (const SimulationError&) {
+    // A body failed (it restored itself): every other body goes back to the step start too, so
+    // the world stays consistent at the last good state.
+    for (int b = 0; b < begun; ++b) bodies_[b]->body().AbortStep();
+    for (RigidIslandBody* rigid : coupled_) rigid->AbortStep();
+    throw;
+  }
+}
+
+void DeformableWorld::StepDeformables(double h, btContactSolverInfo& info, int& begun) {
   // Stage 2: unconstrained implicit step of every deformable body.
   const Vec3 gravity = ToEigen(getGravity());
   UpdateKinematicAttachments();
   auto t = std::chrono::steady_clock::now();
-  for (auto& entry : bodies_) entry->body().BeginStep(h, gravity);
+  for (auto& entry : bodies_) {
+    ++begun;
+    entry->body().BeginStep(h, gravity);
+  }
   stats_.ms_unconstrained = MsSince(t);
   // Stage 3: islands; then Bullet's solver for every rigid island (bodies coupled to
   // deformables are restored and solved again below, with the deformables).
@@ -395,11 +412,11 @@ void DeformableWorld::solveConstraints(btContactSolverInfo& info) {
     AccumulateStats(island_stats);
     stats_.islands++;
   }
-  for (RigidIslandBody* rigid : coupled_) rigid->EndStep();
   stats_.rigid_bodies_coupled = static_cast<int>(coupled_.size());
   // Stage 7: x = x0 + h v (Bullet integrates the rigid transforms next).
   t = std::chrono::steady_clock::now();
   for (auto& entry : bodies_) entry->body().EndStep(h);
+  for (RigidIslandBody* rigid : coupled_) rigid->EndStep();
   stats_.ms_integrate = MsSince(t);
 }
 

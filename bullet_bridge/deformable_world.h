@@ -120,6 +120,8 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
     std::unique_ptr<JointSource> joints;
     int first_entry = -1;  // its solver keeps the warm starts
   };
+  // Stages 2-7 (see solveConstraints); `begun` counts the bodies whose step has begun.
+  void StepDeformables(double h, btContactSolverInfo& info, int& begun);
   // Drives nodes attached to static/kinematic rigid bodies to their current anchors.
   void UpdateKinematicAttachments();
   // Contact partners of every deformable (bounds overlap), union-find islands, coupled rigid

@@ -36,6 +36,8 @@ RigidIslandBody::RigidIslandBody(btRigidBody* body) : body_(body) {
 
 void RigidIslandBody::BeginStep(double h) {
   start_ = body_->getWorldTransform();
+  start_linear_ = body_->getLinearVelocity();
+  start_angular_ = body_->getAngularVelocity();
   inverse_inertia_ = ToEigenMatrix(body_->getInvInertiaTensorWorld());
   inertia_ = CalcSymmetricPseudoInverse(inverse_inertia_);
   // Bullet's solver integrates external forces inside the solve (btSequentialImpulseConstraint-
@@ -55,6 +57,12 @@ void RigidIslandBody::EndStep() {
   body_->setWorldTransform(start_);
   body_->setLinearVelocity(ToBullet(Vec3(v_.head<3>())));
   body_->setAngularVelocity(ToBullet(Vec3(v_.tail<3>())));
+}
+
+void RigidIslandBody::AbortStep() {
+  body_->setWorldTransform(start_);
+  body_->setLinearVelocity(start_linear_);
+  body_->setAngularVelocity(start_angular_);
 }
 
 void RigidIslandBody::SolveSystemColumns(Eigen::Ref<MatX> columns) const {

@@ -22,6 +22,8 @@ class RigidIslandBody final : public IslandBody {
   // Restores the step-start transform (undoing any pass of Bullet's own solver over the body)
   // and writes the solved velocity to the body.
   void EndStep();
+  // Abandons the step: step-start transform and velocity back on the body.
+  void AbortStep();
 
   int num_blocks() const override { return 2; }
   const VecX& v_star() const override { return v_star_; }
@@ -43,6 +45,7 @@ class RigidIslandBody final : public IslandBody {
  private:
   btRigidBody* body_;
   btTransform start_;
+  btVector3 start_linear_, start_angular_;
   VecX v_star_, v_;
   Mat3 inverse_inertia_;  // world frame, step start
   Mat3 inertia_;          // its pseudo-inverse

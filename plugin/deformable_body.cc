@@ -198,10 +198,14 @@ void DeformableBody::CheckVelocities(const char* stage) {
              stage);
 }
 
-void DeformableBody::FailStep(const std::string& what, const char* stage) {
+void DeformableBody::AbortStep() {
   x_ = x0_;
   v_ = v0_;
   external_.setZero();
+}
+
+void DeformableBody::FailStep(const std::string& what, const char* stage) {
+  AbortStep();
   throw SimulationError(internal::Concat("body '", name(), "': ", what, " (stage: ", stage,
                                          "); state kept at step start"));
 }

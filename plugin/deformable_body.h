@@ -71,6 +71,9 @@ class DeformableBody {
   // Stage 7: x = x0 + h v. Throws SimulationError (keeping the step-start state) on NaN/Inf in
   // v or x, or a free node faster than settings.max_speed.
   void EndStep(double h);
+  // Between BeginStep and EndStep: abandons the step (x, v back to the step start, this step's
+  // external forces dropped), e.g. when another body of the world failed its step.
+  void AbortStep();
 
   // Elastic energy at the current x [J].
   double CalcElasticEnergy() const { return model_->CalcEnergy(x_); }

@@ -97,5 +97,36 @@ TEST(DeformableWorldTest, DeformableBodyFallsInsideSubstepsAndRefreshesItsAabb) 
   EXPECT_EQ(scene.world.num_deformable_bodies(), 0);
 }
 
+TEST(DeformableWorldTest, OneBodyFailingItsStepLeavesEveryBodyAtTheLastGoodState) {
+  btDefaultCollisionConfiguration configuration;
+  btCollisionDispatcher dispatcher(&configuration);
+  btDbvtBroadphase broadphase;
+  btSequentialImpulseConstraintSolver solver;
+  DeformableWorld world(&dispatcher, &broadphase, &solver, &configuration);
+  world.setGravity(btVector3(0, 0, -9.81));
+  DeformableBodySettings settings;
+  settings.material = {1e5, 0.3, 1000.0};
+  settings.name = "good";
+  DeformableBody* good = world.AddTetBody(MakeBoxTetMesh(Vec3(0.1, 0.1, 0.1), 1, 1, 1, Vec3(0, 0, 1)), settings);
+  settings.name = "bad";
+  DeformableBody* bad = world.AddTetBody(MakeBoxTetMesh(Vec3(0.1, 0.1, 0.1), 1, 1, 1, Vec3(1, 0, 1)), settings);
+  world.stepSimulation(1.0 / 240.0, 1, 1.0 / 240.0);
+  const VecX good_x = good->x(), good_v = good->v(), bad_x = bad->x();
+  bad->AddNodeForce(0, Vec3(1e300, 0, 0));  // finite, but the node would leave at 1e298 m/s
+  try {
+    world.stepSimulation(1.0 / 240.0, 1, 1.0 / 240.0);
+    FAIL() << "an exploding velocity must fail the step";
+  } catch (const SimulationError& e) {
+    EXPECT_NE(std::string(e.what()).find("body 'bad'"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(good->x(), good_x);  // the healthy body, stepped first, went back too
+  EXPECT_EQ(good->v(), good_v);
+  EXPECT_EQ(bad->x(), bad_x);
+  // And the world steps on afterwards.
+  world.stepSimulation(1.0 / 240.0, 1, 1.0 / 240.0);
+  EXPECT_LT(good->x().maxCoeff(), good_x.maxCoeff() + 1e-12);
+  EXPECT_TRUE(good->x().allFinite());
+}
+
 }  // namespace
 }  // namespace taut
