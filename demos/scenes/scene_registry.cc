@@ -1,5 +1,8 @@
 #include "demos/scenes/armadillo_scene.h"
+#include "demos/scenes/box_on_sphere_scene.h"
+#include "demos/scenes/collapsing_sphere_scene.h"
 #include "demos/scenes/falling_sphere_scene.h"
+#include "demos/scenes/finger_scene.h"
 #include "demos/scenes/hex_beam_scene.h"
 #include "demos/scenes/scene.h"
 #include "demos/scenes/tet_beam_scene.h"
@@ -33,6 +36,22 @@ const std::vector<SceneInfo>& SceneRegistry() {
        "2 MPa linear",
        480, 1.0 / 240.0,
        [] { return std::make_unique<HexBeamScene>(HexBeamScene::DefaultBeams()); }},
+      {"finger",
+       "paper A Fig. 3: a 7 cm, 378-tet finger (E = 2 MPa) pressed with 40 N by a kinematic bone "
+       "onto a table flat, on its side and on its tip, anisotropic vs isotropic limits, one "
+       "press after another",
+       520, 1e-3, [] { return std::make_unique<FingerScene>(FingerScene::DefaultPresses()); }},
+      {"collapsing_sphere",
+       "paper B Fig. 5: 280-hex spheres (R = 1 m, Y = 50 kPa) dropped 0.5 m onto the ground, "
+       "without and with U_e <= 50 J",
+       360, 1.0 / 240.0,
+       [] {
+         return std::make_unique<CollapsingSphereScene>(CollapsingSphereScene::DefaultSpheres());
+       }},
+      {"box_on_sphere",
+       "three rigid boxes (20, 10, 5 kg) stacked on a soft 32-hex sphere (500 kPa, U_e <= 0.5 J) "
+       "on the ground: rigid-rigid contacts inside the deformable island",
+       480, 1.0 / 240.0, [] { return std::make_unique<BoxOnSphereScene>(); }},
   };
   return scenes;
 }

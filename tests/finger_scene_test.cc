@@ -1,0 +1,81 @@
+#include "demos/scenes/finger_scene.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+
+namespace taut {
+namespace {
+
+// Runs every press of the scene to its end.
+void RunPresses(FingerScene& scene, double dt) {
+  for (int step = 0; step < 5000 && scene.current_press() < scene.num_presses(); ++step)
+    scene.Step(dt);
+  ASSERT_EQ(scene.current_press(), scene.num_presses()) << "presses did not finish";
+}
+
+// Paper A §5.2 / Fig. 3: at the same 40 N the anisotropic finger indents like the isotropic one
+// when pressed flat (compliant nail normal, 0.75..1.25), but its tissue locks early on the side
+// (0.98..1.02) and on the tip (0.95..1.05). Each press is compared with the isotropic press on the
+// same side, so the contact geometry (a cylinder on its side, a cap on its tip) cancels.
+TEST(FingerSceneTest, AnisotropicFingerIsCompliantOnlyAlongTheNailNormal) {
+  FingerSceneSettings settings;
+  settings.hold_time = 0.005;
+  FingerScene scene(FingerScene::DefaultPresses(), settings);
+  RunPresses(scene, 1e-3);
+  // DefaultPresses order: flat, side, tip; anisotropic then isotropic.
+  const FingerPressResult* r[3][2];
+  for (int p = 0; p < 6; ++p) {
+    r[p / 2][p % 2] = &scene.result(p);
+    const FingerPressResult& result = scene.result(p);
+    std::printf(
+        "%-17s indentation %.4f mm, reaction %6.2f N (elastic %6.2f N), stop %-5s, "
+        "violation %.1e, penetration %.1e m\n",
+        result.name.c_str(), 1e3 * result.indentation, result.reaction, result.elastic_reaction,
+        result.stop_reason.c_str(), result.max_violation, result.max_penetration);
+    EXPECT_TRUE(result.touched) << result.name;
+    // Accepted steps keep the limits within the solver's tolerance and nothing sinks in.
+    EXPECT_LE(result.max_violation, 2.0 * settings.solver_tolerance) << result.name;
+    EXPECT_LE(result.max_penetration, 1e-6) << result.name;
+  }
+  // Compliant along the nail normal: the full force, indentation within 15 % of isotropic.
+  EXPECT_EQ(r[0][0]->stop_reason, "force");
+  EXPECT_NEAR(r[0][0]->indentation / r[0][1]->indentation, 1.0, 0.15);
+  // Stiff across and along the finger: the tissue locks below the force, at under half the
+  // isotropic indentation.
+  for (int axis : {1, 2}) {
+    EXPECT_EQ(r[axis][0]->stop_reason, "lock") << r[axis][0]->name;
+    EXPECT_LT(r[axis][0]->reaction, settings.target_force) << r[axis][0]->name;
+    EXPECT_LT(r[axis][0]->indentation, 0.5 * r[axis][1]->indentation) << r[axis][0]->name;
+  }
+  // Flat and side share the round cross-section: the anisotropic finger indents at least twice
+  // as deep flat, the isotropic one equally (within 5 %).
+  EXPECT_GT(r[0][0]->indentation, 2.0 * r[1][0]->indentation);
+  EXPECT_NEAR(r[0][1]->indentation / r[1][1]->indentation, 1.0, 0.05);
+  // Isotropic presses reach the target force and no limit row is active, so the energy slope
+  // must equal the elastic force on the bone nodes (the force measure is right).
+  for (int axis = 0; axis < 3; ++axis) {
+    const FingerPressResult& iso = *r[axis][1];
+    EXPECT_EQ(iso.stop_reason, "force") << iso.name;
+    EXPECT_NEAR(iso.reaction, settings.target_force, 0.05 * settings.target_force) << iso.name;
+    EXPECT_NEAR(iso.reaction, iso.elastic_reaction, 0.01 * iso.elastic_reaction) << iso.name;
+  }
+}
+
+TEST(FingerSceneTest, BoneIsInsideTheFleshAndBadSettingsThrow) {
+  FingerScene scene({{FingerPressAxis::kFlat, FingerScene::Isotropic()}});
+  EXPECT_GT(scene.body_mesh().tets.size(), 300u);
+  EXPECT_LT(scene.body_mesh().tets.size(), 450u);
+  const std::vector<int> boundary = CalcBoundaryNodes(scene.body_mesh());
+  ASSERT_FALSE(scene.bone_nodes().empty());
+  for (int node : scene.bone_nodes())
+    EXPECT_FALSE(std::binary_search(boundary.begin(), boundary.end(), node)) << node;
+  FingerSceneSettings bad;
+  bad.target_force = 0.0;
+  EXPECT_THROW(FingerScene({{FingerPressAxis::kTip, FingerScene::Isotropic()}}, bad), InputError);
+  EXPECT_THROW(FingerScene({}), InputError);
+}
+
+}  // namespace
+}  // namespace taut
