@@ -140,6 +140,15 @@ void DeformableWorld::AttachNodesToRigidBody(DeformableBody* body, const std::ve
       *body, FindRigidIslandBody(owned), nodes, std::move(local), next_source_id_++));
 }
 
+void DeformableWorld::SetContactSurface(DeformableBody* body, const SurfaceMesh& surface) {
+  Entry& entry = FindEntry(body);
+  const auto* hexes = dynamic_cast<const HexElementModel*>(&body->model());
+  TAUT_DEMAND(hexes != nullptr, "body '", body->name(),
+              "': SetContactSurface needs a hex body (tet bodies touch through their boundary)");
+  entry.contacts->set_surface(
+      MakeEmbeddedContactSurface(hexes->lattice(), EmbedSurface(hexes->lattice(), surface)));
+}
+
 void DeformableWorld::ClearLimits(DeformableBody* body) { FindEntry(body).sources.clear(); }
 
 void DeformableWorld::RemoveDeformableBody(DeformableBody* body) {

@@ -70,6 +70,12 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   // flesh). The rigid body must be in this world. Throws InputError for a node out of range.
   void AttachNodesToRigidBody(DeformableBody* body, const std::vector<int>& nodes,
                               const btRigidBody* rigid);
+  // Makes `surface` (a closed surface in the body's rest frame, e.g. the one a hex lattice was
+  // voxelized from) the body's contact surface: it is embedded in the hex lattice, and each of
+  // its vertices contacts rigid objects through the 8 nodes of its hex (trilinear weights).
+  // Without it a hex body touches through its lattice's boundary corners. Throws InputError for
+  // a body that is not a hex body or a surface that cannot be embedded.
+  void SetContactSurface(DeformableBody* body, const SurfaceMesh& surface);
   // Removes every constraint source (limits) of the body.
   void ClearLimits(DeformableBody* body);
   // Solver settings used by every constrained body.

@@ -12,18 +12,21 @@
 namespace taut {
 
 namespace {
-// Boundary nodes of a tet or hex body (all nodes for other models), free ones only.
-std::vector<int> CollectSurfaceNodes(const DeformableBody& body) {
-  std::vector<int> nodes;
-  if (const auto* tets = dynamic_cast<const TetElementModel*>(&body.model())) {
-    nodes = CalcBoundaryNodes(tets->mesh());
-  } else {
-    for (int i = 0; i < body.num_nodes(); ++i) nodes.push_back(i);
+// The body's own boundary: tet boundary vertices, hex lattice boundary corners.
+ContactSurface MakeBoundarySurface(const DeformableBody& body) {
+  if (const auto* tets = dynamic_cast<const TetElementModel*>(&body.model()))
+    return MakeTetContactSurface(tets->mesh());
+  if (const auto* hexes = dynamic_cast<const HexElementModel*>(&body.model()))
+    return MakeHexContactSurface(hexes->lattice());
+  ContactSurface all;
+  for (int i = 0; i < body.num_nodes(); ++i) {
+    ContactPoint p;
+    p.num_nodes = 1;
+    p.nodes[0] = i;
+    p.weights[0] = 1.0;
+    all.points.push_back(p);
   }
-  nodes.erase(std::remove_if(nodes.begin(), nodes.end(),
-                             [&](int i) { return body.node_kind(i) != NodeKind::kFree; }),
-              nodes.end());
-  return nodes;
+  return all;
 }
 
 // Two unit tangents orthogonal to n.
@@ -38,12 +41,27 @@ RigidContactSource::RigidContactSource(const DeformableBody& body, int source_id
     : body_(body),
       key_prefix_(static_cast<std::uint64_t>(source_id) << 48),
       friction_(friction),
-      margin_(margin),
-      surface_nodes_(CollectSurfaceNodes(body)) {
+      margin_(margin) {
   TAUT_DEMAND(std::isfinite(friction) && friction >= 0.0, "body '", body.name(),
               "': contact friction must be finite and >= 0, got ", friction);
   TAUT_DEMAND(std::isfinite(margin) && margin > 0.0, "body '", body.name(),
               "': contact margin must be finite and > 0 m, got ", margin);
+  set_surface(MakeBoundarySurface(body));
+}
+
+bool RigidContactSource::Moves(const ContactPoint& point) const {
+  for (int k = 0; k < point.num_nodes; ++k)
+    if (body_.node_kind(point.nodes[k]) == NodeKind::kFree) return true;
+  return false;
+}
+
+void RigidContactSource::set_surface(const ContactSurface& surface) {
+  for (const ContactPoint& p : surface.points)
+    for (int k = 0; k < p.num_nodes; ++k)
+      TAUT_DEMAND(p.nodes[k] >= 0 && p.nodes[k] < body_.num_nodes(), "body '", body_.name(),
+                  "': contact point node ", p.nodes[k], " out of range [0, ", body_.num_nodes(),
+                  ")");
+  points_ = surface.points;
 }
 
 void RigidContactSource::set_objects(const std::vector<const btCollisionObject*>& objects) {
@@ -72,29 +90,33 @@ int RigidContactSource::AppendIslandRows(const IslandIterate& iterate,
     const double mu = friction_ * static_cast<double>(object.getFriction());
     // Stable partner id for warm starting: the object's index in the world.
     const std::uint64_t object_id = static_cast<std::uint64_t>(object.getWorldArrayIndex()) & 4095;
-    for (int node : surface_nodes_) {
-      const Vec3 p = x.segment<3>(3 * node);
+    for (size_t i = 0; i < points_.size(); ++i) {
+      const ContactPoint& point = points_[i];
+      if (!Moves(point)) continue;  // fixed or kinematic: nothing to solve
+      const Vec3 p = CalcContactPointPosition(point, x);
       const PointContact contact =
           CalcPointShapeDistance(p, *object.getCollisionShape(), transform, margin_);
       if (!contact.valid || contact.gap >= margin_) continue;
-      // Normal row C = gap, J = n on the node; then the two tangents (friction on the Coulomb
-      // disk). A dynamic partner's surface point q = p - gap n moves with v + w x (q - com), so
+      // Normal row C = gap, J = w_k n on the point's nodes; then the two tangents (friction on
+      // the Coulomb disk). A dynamic partner's surface point q = p - gap n moves with v + w x (q - com), so
       // its side is J_lin = -d, J_ang = -(q - com) x d for each direction d.
       Vec3 d[3];
       d[0] = contact.normal;
       CalcTangents(contact.normal, d[1], d[2]);
       const Vec3 r = p - contact.gap * contact.normal - com;
       const std::uint64_t key =
-          key_prefix_ | ((static_cast<std::uint64_t>(node) * 4096 + object_id) * 3);
+          key_prefix_ | ((static_cast<std::uint64_t>(i) * 4096 + object_id) * 3);
       for (int k = 0; k < 3; ++k) {
         ConstraintRow& row = rows.emplace_back();
         row.key = key + k;
         row.C = k == 0 ? contact.gap : 0.0;
         row.body = body_index;
         row.type = RowType::kContact;
-        row.num_nodes = 1;
-        row.nodes[0] = node;
-        row.J[0] = d[k];
+        row.num_nodes = point.num_nodes;
+        for (int n = 0; n < point.num_nodes; ++n) {
+          row.nodes[n] = point.nodes[n];
+          row.J[n] = point.weights[n] * d[k];
+        }
         row.friction_of = k;
         row.mu = mu;
         if (rigid_index >= 0) {
@@ -111,13 +133,11 @@ int RigidContactSource::AppendIslandRows(const IslandIterate& iterate,
   return static_cast<int>(rows.size()) - before;
 }
 
-double RigidContactSource::CalcNodeGap(const IslandIterate& iterate, const VecX& x,
-                                       int node) const {
+double RigidContactSource::CalcPointGap(const IslandIterate& iterate, const Vec3& p) const {
   double gap = std::numeric_limits<double>::infinity();
   for (size_t o = 0; o < partners_.size(); ++o) {
-    const PointContact contact =
-        CalcPointShapeDistance(x.segment<3>(3 * node), *partners_[o].object->getCollisionShape(),
-                               CalcPartnerTransform(iterate, o), margin_);
+    const PointContact contact = CalcPointShapeDistance(
+        p, *partners_[o].object->getCollisionShape(), CalcPartnerTransform(iterate, o), margin_);
     if (contact.valid) gap = std::min(gap, contact.gap);
   }
   return gap;
@@ -126,14 +146,16 @@ double RigidContactSource::CalcNodeGap(const IslandIterate& iterate, const VecX&
 double RigidContactSource::CalcIslandMaxViolation(const IslandIterate& iterate) const {
   const VecX& x = iterate.x(iterate.IndexOf(&body_));
   double violation = 0.0;
-  for (int node : surface_nodes_) violation = std::max(violation, -CalcNodeGap(iterate, x, node));
+  for (const ContactPoint& point : points_)
+    if (Moves(point)) violation = std::max(violation, -CalcPointGap(iterate, CalcContactPointPosition(point, x)));
   return violation;
 }
 
 double RigidContactSource::CalcIslandViolationSum(const IslandIterate& iterate) const {
   const VecX& x = iterate.x(iterate.IndexOf(&body_));
   double sum = 0.0;
-  for (int node : surface_nodes_) sum += std::max(0.0, -CalcNodeGap(iterate, x, node));
+  for (const ContactPoint& point : points_)
+    if (Moves(point)) sum += std::max(0.0, -CalcPointGap(iterate, CalcContactPointPosition(point, x)));
   return sum;
 }
 

@@ -10,6 +10,7 @@
 
 #include "bullet_bridge/rigid_island_body.h"
 #include "constraints/constraint_row.h"
+#include "plugin/contact_surface.h"
 
 namespace taut {
 
@@ -22,8 +23,13 @@ struct ContactPartner {
 class RigidContactSource final : public ConstraintSource {
  public:
   // `friction` is the body's Coulomb coefficient, combined with each object's by the product
-  // (Bullet's default combiner); `margin` [m] is how close a node must be to get rows.
+  // (Bullet's default combiner); `margin` [m] is how close a point must be to get rows. The
+  // contact points are the body's boundary (MakeTetContactSurface / MakeHexContactSurface).
   RigidContactSource(const DeformableBody& body, int source_id, double friction, double margin);
+
+  // Replaces the contact points (e.g. a surface embedded in a hex body: 8-node rows). Points
+  // whose nodes are all fixed or kinematic get no rows.
+  void set_surface(const ContactSurface& surface);
 
   const DeformableBody& body() const { return body_; }
   // The partners to test this step (those whose bounds overlap the body's).
@@ -39,14 +45,16 @@ class RigidContactSource final : public ConstraintSource {
  private:
   // Transform of partner o at the iterate (dynamic partners move with their velocity).
   btTransform CalcPartnerTransform(const IslandIterate& iterate, size_t o) const;
-  // Smallest gap of node i over the partners at the iterate (+inf when none is within the margin).
-  double CalcNodeGap(const IslandIterate& iterate, const VecX& x, int node) const;
+  // True when a node of the point moves freely.
+  bool Moves(const ContactPoint& point) const;
+  // Smallest gap of point p over the partners at the iterate (+inf when none is within the margin).
+  double CalcPointGap(const IslandIterate& iterate, const Vec3& p) const;
 
   const DeformableBody& body_;
   std::uint64_t key_prefix_;
   double friction_;
   double margin_;
-  std::vector<int> surface_nodes_;  // free boundary nodes
+  std::vector<ContactPoint> points_;
   std::vector<ContactPartner> partners_;
 };
 
