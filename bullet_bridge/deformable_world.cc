@@ -71,6 +71,11 @@ DeformableBody* DeformableWorld::AddDeformableBody(std::unique_ptr<DeformableBod
   DeformableBody& added = entry->object->body();
   entry->contacts = std::make_unique<RigidContactSource>(
       added, next_source_id_++, added.settings().friction, added.settings().contact_margin);
+  if (const auto* tets = dynamic_cast<const TetElementModel*>(&added.model())) {
+    entry->surface = MakeTetContactSurface(tets->mesh());
+  } else if (const auto* hexes = dynamic_cast<const HexElementModel*>(&added.model())) {
+    entry->surface = MakeHexContactSurface(hexes->lattice());
+  }
   bodies_.push_back(std::move(entry));
   addCollisionObject(&bodies_.back()->collision_object(), btBroadphaseProxy::DefaultFilter,
                      btBroadphaseProxy::AllFilter);
@@ -145,8 +150,17 @@ void DeformableWorld::SetContactSurface(DeformableBody* body, const SurfaceMesh&
   const auto* hexes = dynamic_cast<const HexElementModel*>(&body->model());
   TAUT_DEMAND(hexes != nullptr, "body '", body->name(),
               "': SetContactSurface needs a hex body (tet bodies touch through their boundary)");
-  entry.contacts->set_surface(
-      MakeEmbeddedContactSurface(hexes->lattice(), EmbedSurface(hexes->lattice(), surface)));
+  ContactSurface embedded =
+      MakeEmbeddedContactSurface(hexes->lattice(), EmbedSurface(hexes->lattice(), surface));
+  entry.contacts->set_surface(embedded);
+  // Other deformables still touch the lattice's boundary triangles; this body touches them
+  // through the embedded points.
+  embedded.triangles = MakeHexContactSurface(hexes->lattice()).triangles;
+  embedded.node_triangles = false;
+  entry.surface = std::move(embedded);
+  for (auto it = pair_contacts_.begin(); it != pair_contacts_.end();)
+    it = (it->first.first == &entry || it->first.second == &entry) ? pair_contacts_.erase(it)
+                                                                    : std::next(it);
 }
 
 void DeformableWorld::ClearLimits(DeformableBody* body) { FindEntry(body).sources.clear(); }
@@ -156,6 +170,10 @@ void DeformableWorld::RemoveDeformableBody(DeformableBody* body) {
                          [body](const auto& entry) { return &entry->body() == body; });
   TAUT_DEMAND(it != bodies_.end(), "RemoveDeformableBody: body is not in this world");
   removeCollisionObject(&(*it)->collision_object());
+  for (auto pair = pair_contacts_.begin(); pair != pair_contacts_.end();)
+    pair = (pair->first.first == it->get() || pair->first.second == it->get())
+               ? pair_contacts_.erase(pair)
+               : std::next(pair);
   bodies_.erase(it);
 }
 
@@ -230,9 +248,11 @@ void DeformableWorld::BuildIslands(double h, const btContactSolverInfo& info) {
   for (int d = 0; d < num_deformables; ++d) {
     Entry& entry = *bodies_[d];
     entry.partners.clear();
-    Vec3 lo, hi;
-    CalcSweptBounds(entry.body(), h, entry.body().settings().contact_margin + h * max_rigid_speed,
-                    lo, hi);
+    CalcSweptBounds(entry.body(), h, entry.body().settings().contact_margin, entry.swept_lo,
+                    entry.swept_hi);
+    // Rigid partners may move too: grow by their fastest motion this step.
+    const Vec3 lo = entry.swept_lo.array() - h * max_rigid_speed;
+    const Vec3 hi = entry.swept_hi.array() + h * max_rigid_speed;
     for (int i = 0; i < objects.size(); ++i) {
       const btCollisionObject* object = objects[i];
       if (object->getCollisionShape()->getShapeType() == kDeformableShapeType) continue;
@@ -249,6 +269,28 @@ void DeformableWorld::BuildIslands(double h, const btContactSolverInfo& info) {
     for (const auto& attachment : entry.dynamic_attachments)
       if (DynamicIndex(*attachment->rigid()->rigid()) >= 0)
         union_find_.Unite(d, DynamicIndex(*attachment->rigid()->rigid()));
+  }
+  // Deformables whose swept bounds overlap share an island and a pair contact source.
+  active_pairs_.clear();
+  for (int d = 0; d < num_deformables; ++d) {
+    for (int e = d + 1; e < num_deformables; ++e) {
+      const Entry& first = *bodies_[d];
+      const Entry& second = *bodies_[e];
+      if ((first.swept_lo.array() > second.swept_hi.array()).any() ||
+          (second.swept_lo.array() > first.swept_hi.array()).any())
+        continue;
+      union_find_.Unite(d, e);
+      auto& source = pair_contacts_[{&first, &second}];
+      if (source == nullptr) {
+        const DeformableBodySettings& a = first.object->body().settings();
+        const DeformableBodySettings& b = second.object->body().settings();
+        source = std::make_unique<DeformableContactSource>(
+            first.object->body(), first.surface, second.object->body(), second.surface,
+            next_source_id_++, a.friction * b.friction,
+            std::max(a.contact_margin, b.contact_margin));
+      }
+      active_pairs_.emplace_back(d, source.get());
+    }
   }
   // Rigid bodies touching each other (Bullet's manifolds with points) share an island.
   btDispatcher* dispatcher = getDispatcher();
@@ -350,6 +392,7 @@ void DeformableWorld::BuildIslands(double h, const btContactSolverInfo& info) {
     }
     for (auto& attachment : entry->dynamic_attachments) island.sources.push_back(attachment.get());
   }
+  for (const auto& [d, source] : active_pairs_) islands_[bodies_[d]->island].sources.push_back(source);
   for (int i = 0; i < num_islands_; ++i) {
     if (islands_[i].manifolds->num_points() > 0)
       islands_[i].sources.push_back(islands_[i].manifolds.get());

@@ -4,6 +4,7 @@
 #include <BulletCollision/CollisionDispatch/btEmptyCollisionAlgorithm.h>
 #include <BulletDynamics/Dynamics/btDiscreteDynamicsWorld.h>
 
+#include <map>
 #include <memory>
 #include <unordered_map>
 #include <vector>
@@ -14,6 +15,7 @@
 #include "bullet_bridge/rigid_contact_source.h"
 #include "bullet_bridge/rigid_island_body.h"
 #include "bullet_bridge/rigid_manifold_source.h"
+#include "constraints/deformable_contact_source.h"
 #include "constraints/deformable_island_body.h"
 #include "constraints/union_find.h"
 #include "constraints/energy_limit_constraint.h"
@@ -113,6 +115,8 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
     std::vector<Attachment> attachments;
     std::vector<std::unique_ptr<NodeAttachmentSource>> dynamic_attachments;
     std::vector<ContactPartner> partners;  // this step
+    ContactSurface surface;                // contact points and triangles
+    Vec3 swept_lo, swept_hi;               // bounds of this step's motion, grown by the margin
     SqpSolver solver;
     int island = -1;  // this step
     DeformableBody& body() { return object->body(); }
@@ -147,6 +151,10 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
 
   std::vector<std::unique_ptr<Entry>> bodies_;
   std::unordered_map<const btCollisionObject*, std::unique_ptr<RigidIslandBody>> rigid_bodies_;
+  // Contact sources of deformable pairs (kept across steps for warm starts), and this step's.
+  std::map<std::pair<const Entry*, const Entry*>, std::unique_ptr<DeformableContactSource>>
+      pair_contacts_;
+  std::vector<std::pair<int, DeformableContactSource*>> active_pairs_;  // (first entry, source)
   // Per-step scratch (kept to avoid allocations): dynamic rigid bodies, their union-find index
   // by world array index, the coupled ones, islands.
   std::vector<btRigidBody*> dynamic_;

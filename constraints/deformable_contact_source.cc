@@ -1,0 +1,188 @@
+#include "constraints/deformable_contact_source.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace taut {
+
+namespace internal {
+
+Vec3 CalcNearestTrianglePoint(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  // Voronoi regions of the vertices, edges and face, in that order.
+  const Vec3 ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0.0 && d2 <= 0.0) return Vec3(1, 0, 0);
+  const Vec3 bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0.0 && d4 <= d3) return Vec3(0, 1, 0);
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) {
+    const double v = d1 / (d1 - d3);
+    return Vec3(1 - v, v, 0);
+  }
+  const Vec3 cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0.0 && d5 <= d6) return Vec3(0, 0, 1);
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) {
+    const double w = d2 / (d2 - d6);
+    return Vec3(1 - w, 0, w);
+  }
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) {
+    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return Vec3(0, 1 - w, w);
+  }
+  const double denom = 1.0 / (va + vb + vc);
+  const double v = vb * denom, w = vc * denom;
+  return Vec3(1 - v - w, v, w);
+}
+
+}  // namespace internal
+
+namespace {
+// Two unit tangents orthogonal to n.
+void CalcTangents(const Vec3& n, Vec3& t1, Vec3& t2) {
+  t1 = (std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized();
+  t2 = n.cross(t1);
+}
+
+// Node of a triangle corner (node triangles: every corner point is one node).
+int CornerNode(const ContactSurface& surface, int triangle, int corner) {
+  return surface.points[surface.triangles[triangle][corner]].nodes[0];
+}
+}  // namespace
+
+DeformableContactSource::DeformableContactSource(const DeformableBody& a,
+                                                 const ContactSurface& surface_a,
+                                                 const DeformableBody& b,
+                                                 const ContactSurface& surface_b, int source_id,
+                                                 double friction, double margin)
+    : a_(a),
+      b_(b),
+      surfaces_{surface_a, surface_b},
+      key_prefix_(static_cast<std::uint64_t>(source_id) << 48),
+      friction_(friction),
+      margin_(margin) {
+  TAUT_DEMAND(&a != &b, "body '", a.name(), "': deformable contact needs two different bodies");
+  TAUT_DEMAND(std::isfinite(friction) && friction >= 0.0, "bodies '", a.name(), "' and '",
+              b.name(), "': contact friction must be finite and >= 0, got ", friction);
+  TAUT_DEMAND(std::isfinite(margin) && margin > 0.0, "bodies '", a.name(), "' and '", b.name(),
+              "': contact margin must be finite and > 0 m, got ", margin);
+}
+
+bool DeformableContactSource::FindNearestTriangle(const ContactSurface& surface, const VecX& x,
+                                                  const Vec3& p, Hit& hit) const {
+  double best = margin_;
+  bool found = false;
+  for (size_t t = 0; t < surface.triangles.size(); ++t) {
+    const Vec3 v0 = x.segment<3>(3 * CornerNode(surface, static_cast<int>(t), 0));
+    const Vec3 v1 = x.segment<3>(3 * CornerNode(surface, static_cast<int>(t), 1));
+    const Vec3 v2 = x.segment<3>(3 * CornerNode(surface, static_cast<int>(t), 2));
+    // Cheap rejection by the triangle's bounds grown by the margin.
+    const Vec3 lo = v0.cwiseMin(v1).cwiseMin(v2).array() - margin_;
+    const Vec3 hi = v0.cwiseMax(v1).cwiseMax(v2).array() + margin_;
+    if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) continue;
+    const Vec3 beta = internal::CalcNearestTrianglePoint(p, v0, v1, v2);
+    const Vec3 q = beta[0] * v0 + beta[1] * v1 + beta[2] * v2;
+    const double distance = (p - q).norm();
+    if (distance >= best) continue;
+    const Vec3 normal = (v1 - v0).cross(v2 - v0);
+    if (normal.squaredNorm() == 0.0) continue;  // degenerate triangle
+    best = distance;
+    found = true;
+    hit.triangle = static_cast<int>(t);
+    hit.beta = beta;
+    hit.normal = normal.normalized();
+    hit.gap = hit.normal.dot(p - q);
+  }
+  return found;
+}
+
+void DeformableContactSource::FindHits(const VecX& xa, const VecX& xb) const {
+  hits_.clear();
+  const VecX* x[2] = {&xa, &xb};
+  for (int direction = 0; direction < 2; ++direction) {
+    const ContactSurface& points = surfaces_[direction];
+    const ContactSurface& target = surfaces_[1 - direction];
+    if (!target.node_triangles || target.triangles.empty()) continue;
+    const VecX& xp = *x[direction];
+    const VecX& xt = *x[1 - direction];
+    // Bounds of the target's nodes, grown by the margin: points outside skip the search.
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (const ContactPoint& corner : target.points) {
+      lo = lo.cwiseMin(Vec3(xt.segment<3>(3 * corner.nodes[0])));
+      hi = hi.cwiseMax(Vec3(xt.segment<3>(3 * corner.nodes[0])));
+    }
+    lo.array() -= margin_;
+    hi.array() += margin_;
+    for (size_t i = 0; i < points.points.size(); ++i) {
+      const Vec3 p = CalcContactPointPosition(points.points[i], xp);
+      if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) continue;
+      Hit hit;
+      if (!FindNearestTriangle(target, xt, p, hit)) continue;
+      hit.direction = direction;
+      hit.point = static_cast<int>(i);
+      hits_.push_back(hit);
+    }
+  }
+}
+
+int DeformableContactSource::AppendIslandRows(const IslandIterate& iterate,
+                                              std::vector<ConstraintRow>& rows) {
+  const int ia = iterate.IndexOf(&a_), ib = iterate.IndexOf(&b_);
+  FindHits(iterate.x(ia), iterate.x(ib));
+  const int before = static_cast<int>(rows.size());
+  const int index[2] = {ia, ib};
+  for (const Hit& hit : hits_) {
+    const ContactSurface& points = surfaces_[hit.direction];
+    const ContactSurface& target = surfaces_[1 - hit.direction];
+    const ContactPoint& point = points.points[hit.point];
+    Vec3 d[3];
+    d[0] = hit.normal;
+    CalcTangents(hit.normal, d[1], d[2]);
+    const std::uint64_t key =
+        key_prefix_ | ((static_cast<std::uint64_t>(hit.point) * 2 + hit.direction) *
+                           (std::uint64_t{1} << 20) +
+                       static_cast<std::uint64_t>(hit.triangle)) *
+                          3;
+    for (int k = 0; k < 3; ++k) {
+      ConstraintRow& row = rows.emplace_back();
+      row.key = key + k;
+      row.C = k == 0 ? hit.gap : 0.0;
+      row.type = RowType::kContact;
+      row.friction_of = k;
+      row.mu = friction_;
+      row.body = index[hit.direction];
+      row.num_nodes = point.num_nodes;
+      for (int n = 0; n < point.num_nodes; ++n) {
+        row.nodes[n] = point.nodes[n];
+        row.J[n] = point.weights[n] * d[k];
+      }
+      row.body2 = index[1 - hit.direction];
+      row.num_nodes2 = 3;
+      for (int c = 0; c < 3; ++c) {
+        row.nodes2[c] = CornerNode(target, hit.triangle, c);
+        row.J2[c] = -hit.beta[c] * d[k];
+      }
+    }
+  }
+  return static_cast<int>(rows.size()) - before;
+}
+
+double DeformableContactSource::CalcIslandMaxViolation(const IslandIterate& iterate) const {
+  FindHits(iterate.x(iterate.IndexOf(&a_)), iterate.x(iterate.IndexOf(&b_)));
+  double violation = 0.0;
+  for (const Hit& hit : hits_) violation = std::max(violation, -hit.gap);
+  return violation;
+}
+
+double DeformableContactSource::CalcIslandViolationSum(const IslandIterate& iterate) const {
+  FindHits(iterate.x(iterate.IndexOf(&a_)), iterate.x(iterate.IndexOf(&b_)));
+  double sum = 0.0;
+  for (const Hit& hit : hits_) sum += std::max(0.0, -hit.gap);
+  return sum;
+}
+
+}  // namespace taut
