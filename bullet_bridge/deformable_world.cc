@@ -1,6 +1,7 @@
 #include "bullet_bridge/deformable_world.h"
 
 #include <BulletCollision/CollisionDispatch/btCollisionDispatcher.h>
+#include <BulletCollision/CollisionShapes/btPolyhedralConvexShape.h>
 #include <BulletDynamics/Dynamics/btRigidBody.h>
 
 #include <algorithm>
@@ -259,6 +260,13 @@ void DeformableWorld::BuildIslands(double h, const btContactSolverInfo& info) {
       if (object->hasContactResponse() == false || object->getBroadphaseHandle() == nullptr)
         continue;
       if (!Overlaps(lo, hi, *object->getBroadphaseHandle())) continue;
+      // Face planes of polyhedral shapes (made once per shape) give exact inside distances.
+      if (object->getCollisionShape()->isPolyhedral() &&
+          object->getCollisionShape()->getShapeType() != BOX_SHAPE_PROXYTYPE) {
+        auto* shape = const_cast<btPolyhedralConvexShape*>(
+            static_cast<const btPolyhedralConvexShape*>(object->getCollisionShape()));
+        if (shape->getConvexPolyhedron() == nullptr) shape->initializePolyhedralFeatures();
+      }
       if (dynamic_index_[i] >= 0) {
         union_find_.Unite(d, dynamic_index_[i]);
         entry.partners.push_back({object, nullptr});  // rigid island body filled in below

@@ -11,6 +11,7 @@
 #include <BulletCollision/CollisionShapes/btSphereShape.h>
 #include <BulletCollision/CollisionShapes/btStaticPlaneShape.h>
 #include <BulletCollision/CollisionShapes/btTriangleCallback.h>
+#include <BulletCollision/CollisionShapes/btConvexPolyhedron.h>
 #include <BulletCollision/NarrowPhaseCollision/btGjkEpa2.h>
 
 #include <algorithm>
@@ -208,6 +209,32 @@ PointContact CalcGjkPointDistance(const Vec3& point, const btConvexShape& shape,
   return out;
 }
 
+// Point inside a polyhedral shape with face planes (initializePolyhedralFeatures called): the
+// signed distance to the margin-expanded surface is max_f (n_f . p + d_f) - margin, attained on
+// the face f of the largest plane value (exact for a convex polytope). Returns false for a point
+// outside the polytope (GJK answers those: EPA misreports inside points near vertices, see
+// docs/narrowphase.md).
+bool CalcPolyhedronInsideDistance(const Vec3& p, const btPolyhedralConvexShape& shape,
+                                  LocalContact& out) {
+  const btConvexPolyhedron* polyhedron = shape.getConvexPolyhedron();
+  if (polyhedron == nullptr || polyhedron->m_faces.size() == 0) return false;
+  double best = -std::numeric_limits<double>::infinity();
+  Vec3 normal = Vec3::Zero();
+  for (int f = 0; f < polyhedron->m_faces.size(); ++f) {
+    const btScalar* plane = polyhedron->m_faces[f].m_plane;
+    const Vec3 n(plane[0], plane[1], plane[2]);
+    const double value = n.dot(p) + static_cast<double>(plane[3]);
+    if (value > best) {
+      best = value;
+      normal = n;
+    }
+  }
+  if (best > 0.0) return false;
+  const double gap = best - static_cast<double>(shape.getMargin());
+  out = {gap, normal, p - gap * normal};
+  return true;
+}
+
 }  // namespace internal
 
 PointContact CalcPointShapeDistance(const Vec3& point, const btCollisionShape& shape,
@@ -263,8 +290,13 @@ PointContact CalcPointShapeDistance(const Vec3& point, const btCollisionShape& s
       }
       break;
     }
-    default:
-      if (shape.isConvex()) {
+    default: {
+      LocalContact inside;
+      if (shape.isPolyhedral() &&
+          internal::CalcPolyhedronInsideDistance(
+              p, static_cast<const btPolyhedralConvexShape&>(shape), inside)) {
+        result = ToWorld(inside, transform);
+      } else if (shape.isConvex()) {
         result = internal::CalcGjkPointDistance(point, static_cast<const btConvexShape&>(shape),
                                                 transform);
       } else if (shape.isConcave()) {
@@ -279,6 +311,7 @@ PointContact CalcPointShapeDistance(const Vec3& point, const btCollisionShape& s
         TAUT_DEMAND(false, "CalcPointShapeDistance: unsupported Bullet shape type ", type, " (",
                     shape.getName(), ")");
       }
+    }
   }
   if (!result.valid || result.gap > max_distance) return none;
   return result;

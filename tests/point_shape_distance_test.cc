@@ -369,3 +369,36 @@ TEST(PointShapeDistanceTest, TimingPerShape) {
 
 }  // namespace
 }  // namespace taut
+
+namespace taut {
+namespace {
+
+// With face planes (initializePolyhedralFeatures), inside points of a hull are measured exactly
+// against the planes, including the near-vertex points where EPA misreports the sign
+// (docs/narrowphase.md): octahedron |x| + |y| + |z| <= 0.5, depth (|x|+|y|+|z| - 0.5)/sqrt(3).
+TEST(PointShapeDistanceTest, HullInsidePointsUseFacePlanesWhenAvailable) {
+  btConvexHullShape hull;
+  for (int k = 0; k < 6; ++k) hull.addPoint(ToBullet((k < 3 ? 0.5 : -0.5) * Vec3::Unit(k % 3)));
+  hull.initializePolyhedralFeatures();
+  const double margin = hull.getMargin();
+  btTransform t(btQuaternion(btVector3(1, 2, 3).normalized(), 0.7), btVector3(0.3, -0.2, 1.0));
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  int tested = 0;
+  for (int i = 0; i < 10000 && tested < 500; ++i) {
+    const Vec3 local(u(rng), u(rng), u(rng));
+    const double l1 = local.cwiseAbs().sum();
+    if (l1 >= 0.5) continue;
+    ++tested;
+    const Vec3 world = ToEigen(t * ToBullet(local));
+    const PointContact c = CalcPointShapeDistance(world, hull, t, 1.0);
+    ASSERT_TRUE(c.valid);
+    EXPECT_NEAR(c.gap, (l1 - 0.5) / std::sqrt(3.0) - margin, 1e-12) << "point " << local.transpose();
+    const Vec3 expected_normal = ToEigen(t.getBasis() * ToBullet(Vec3(local.array().sign()) / std::sqrt(3.0)));
+    if ((local.cwiseAbs().array() > 1e-9).all()) EXPECT_GT(c.normal.dot(expected_normal), 1.0 - 1e-9);
+  }
+  EXPECT_EQ(tested, 500);
+}
+
+}  // namespace
+}  // namespace taut
