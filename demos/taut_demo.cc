@@ -29,7 +29,7 @@ int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::strin
   std::ofstream csv(out_dir + "/steps.csv");
   csv.precision(17);
   csv << "step,time_s,ms_step,ms_unconstrained,ms_rows,ms_solve,ms_rigid,rows_strain,"
-         "rows_energy,rows_contact,pgs_sweeps,sqp_iterations,restoration_iterations,active_set_solves,"
+         "rows_energy,rows_contact,rows_rigid_contact,rows_joint,islands,rigid_bodies_coupled,pgs_sweeps,sqp_iterations,restoration_iterations,active_set_solves,"
          "violation_before,violation_after,stationarity,converged";
   for (const std::string& column : scene->CsvColumns()) csv << "," << column;
   csv << "\n";
@@ -54,7 +54,8 @@ int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::strin
     max_violation = std::max(max_violation, s.violation_after);
     csv << step << "," << step * dt << "," << ms << "," << s.ms_unconstrained << "," << s.ms_rows
         << "," << s.ms_solve << "," << s.ms_rigid << "," << s.rows_strain << "," << s.rows_energy
-        << "," << s.rows_contact << "," << s.pgs_sweeps << "," << s.sqp_iterations << ","
+        << "," << s.rows_contact << "," << s.rows_rigid_contact << "," << s.rows_joint << ","
+        << s.islands << "," << s.rigid_bodies_coupled << "," << s.pgs_sweeps << "," << s.sqp_iterations << ","
         << s.restoration_iterations << "," << s.active_set_solves << "," << s.violation_before
         << "," << s.violation_after << "," << s.stationarity << "," << (s.converged ? 1 : 0);
     values.clear();
@@ -75,6 +76,8 @@ int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::strin
   summary["steps"] = steps;
   summary["dt"] = dt;
   summary["ms_per_step_median"] = Median(ms_steps);
+  // A 1/60 s display frame takes (1/60) / dt steps.
+  summary["ms_per_frame_60hz"] = Median(ms_steps) / (60.0 * dt);
   summary["wall_time_s"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
   summary["max_violation"] = max_violation;
@@ -82,6 +85,7 @@ int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::strin
   summary["mean_sqp_iterations"] = steps > 0 ? total_sqp / steps : 0.0;
   summary["unconverged_steps"] = unconverged_steps;
   summary["pgs_sweeps_total"] = total_sweeps;
+  summary["pgs_sweeps_per_step_mean"] = steps > 0 ? static_cast<double>(total_sweeps) / steps : 0.0;
   char hash[32];
   std::snprintf(hash, sizeof(hash), "%016llx",
                 static_cast<unsigned long long>(scene->CalcStateHash()));
