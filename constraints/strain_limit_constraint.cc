@@ -1,6 +1,9 @@
 #include "constraints/strain_limit_constraint.h"
 
 #include <algorithm>
+#include <cmath>
+
+#include "plugin/tet_rest_data.h"
 
 namespace taut {
 
@@ -21,6 +24,32 @@ StrainLimitConstraint::StrainLimitConstraint(const DeformableBody& body,
               " out of range");
   params_ = CalcStrainLimitParams(settings_);
   key_prefix_ = static_cast<std::uint64_t>(source_id) << 48;
+  // Hyperbolic and ellipsoid rows of principal axis i have C = 1 - kappa_eff (s_i - 1) with
+  // kappa_eff <= max_j kappa^j (|V'_ji| <= 1; ||K w|| <= max kappa), so no row of an element is
+  // active (C < tau) while every stretch lies in [1 - (1-tau)/max kappa_min,
+  // 1 + (1-tau)/max kappa_max].
+  screen_ = settings_.projection == StrainProjection::kHyperbolic ||
+            settings_.projection == StrainProjection::kEllipsoid;
+  const double slack = 1.0 - params_.activation_margin;
+  stretch_hi_ = params_.has_max ? 1.0 + slack / params_.kappa_max.maxCoeff() : HUGE_VAL;
+  stretch_lo_ = params_.has_min ? 1.0 - slack / params_.kappa_min.maxCoeff() : 0.0;
+  screen_ = screen_ && std::isfinite(slack) && slack > 0.0;
+}
+
+bool StrainLimitConstraint::IsSurelyInactive(const std::array<Vec3, 4>& xe, int e) const {
+  if (!screen_) return false;
+  // Principal stretches are the square roots of the eigenvalues of F^T F, which lie in the
+  // union of its Gershgorin discs; a non-positive det F (inverted) is never screened out.
+  const Mat3 F = CalcTetDeformationGradient(tets_.rest().elements[e], xe);
+  if (!(F.determinant() > 0.0)) return false;
+  const Mat3 c = F.transpose() * F;
+  double lo = HUGE_VAL, hi = -HUGE_VAL;
+  for (int k = 0; k < 3; ++k) {
+    const double radius = std::abs(c(k, 0)) + std::abs(c(k, 1)) + std::abs(c(k, 2)) - std::abs(c(k, k));
+    lo = std::min(lo, c(k, k) - radius);
+    hi = std::max(hi, c(k, k) + radius);
+  }
+  return lo > 0.0 && stretch_lo_ * stretch_lo_ < lo && hi < stretch_hi_ * stretch_hi_;
 }
 
 int StrainLimitConstraint::AppendRows(const VecX& x, int body_index,
@@ -29,6 +58,7 @@ int StrainLimitConstraint::AppendRows(const VecX& x, int body_index,
   for (int e = 0; e < tets_.num_elements(); ++e) {
     element_rows_.clear();
     const auto xe = tets_.GatherElement(x, e);
+    if (IsSurelyInactive(xe, e)) continue;
     if (AppendStrainLimitRows(e, tets_.rest().elements[e].r, xe,
                               SelectStrainLimitFrame(settings_, e), params_, &element_rows_) == 0)
       continue;
@@ -50,7 +80,9 @@ int StrainLimitConstraint::AppendRows(const VecX& x, int body_index,
 }
 
 double StrainLimitConstraint::CalcElementViolation(const VecX& x, int e) const {
-  return CalcStrainLimitViolation(tets_.rest().elements[e].r, tets_.GatherElement(x, e),
+  const auto xe = tets_.GatherElement(x, e);
+  if (IsSurelyInactive(xe, e)) return 0.0;
+  return CalcStrainLimitViolation(tets_.rest().elements[e].r, xe,
                                   SelectStrainLimitFrame(settings_, e), params_);
 }
 

@@ -1,6 +1,9 @@
 // Strain limits of one tet body as a source of SQP rows (paper A; MATH.md §2-§3).
 #pragma once
 
+#include <array>
+#include <cmath>
+
 #include "constraints/constraint_row.h"
 #include "constraints/strain_limit_rows.h"
 #include "plugin/tet_element_model.h"
@@ -27,6 +30,10 @@ class StrainLimitConstraint final : public BodyConstraintSource {
  private:
   // Largest violation of element e at x.
   double CalcElementViolation(const VecX& x, int e) const;
+  // True when element e (positions xe) certainly has no active row: all its principal stretches
+  // (bounded by Gershgorin discs of F^T F) lie well inside the limits (hyperbolic and ellipsoid
+  // modes; the bound is in the constructor). Saves the SVD of untouched elements.
+  bool IsSurelyInactive(const std::array<Vec3, 4>& xe, int e) const;
 
   const DeformableBody& body_;
   const TetElementModel& tets_;
@@ -34,6 +41,8 @@ class StrainLimitConstraint final : public BodyConstraintSource {
   StrainLimitParams params_;
   std::uint64_t key_prefix_;
   std::vector<StrainLimitRow> element_rows_;  // scratch, reused
+  bool screen_ = false;                       // IsSurelyInactive applies
+  double stretch_lo_ = 0.0, stretch_hi_ = HUGE_VAL;  // stretches that certainly emit no row
 };
 
 }  // namespace taut
