@@ -421,6 +421,7 @@ void DeformableWorld::AccumulateStats(const StepStats& island_stats) {
   stats_.restoration_iterations += island_stats.restoration_iterations;
   stats_.active_set_solves += island_stats.active_set_solves;
   stats_.stationarity = std::max(stats_.stationarity, island_stats.stationarity);
+  stats_.lcp_residual = std::max(stats_.lcp_residual, island_stats.lcp_residual);
   stats_.violation_before = std::max(stats_.violation_before, island_stats.violation_before);
   stats_.violation_after = std::max(stats_.violation_after, island_stats.violation_after);
   stats_.converged = stats_.converged && island_stats.converged;

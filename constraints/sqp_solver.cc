@@ -259,10 +259,11 @@ void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     pgs_settings.w_workspace = &w_;
     const PgsStats pgs = SolvePgs(W_, q_, pgs_rows_, lambda_qp_, pgs_settings);
     stats.pgs_sweeps += pgs.sweeps;
+    stats.lcp_residual = pgs.residual;
     if (settings.polish_active_set && pgs.residual > settings.polish.tolerance) {
       stats.active_set_solves++;
-      PolishActiveSet(W_, q_, pgs_rows_, lambda_qp_, settings.pgs, settings.polish,
-                      &stats.pgs_sweeps);
+      stats.lcp_residual = PolishActiveSet(W_, q_, pgs_rows_, lambda_qp_, settings.pgs,
+                                           settings.polish, &stats.pgs_sweeps);
     }
     // v_QP = v* + Y lambda_QP (restoration: v_k + Y dlambda).
     for (size_t b = 0; b < nb; ++b) {

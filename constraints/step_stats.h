@@ -27,6 +27,9 @@ struct StepStats {
   double violation_before = 0.0;  // at the unconstrained prediction x*
   double violation_after = 0.0;   // at the end of the step
   double stationarity = 0.0;      // ||A(v - v*) - J^T lambda|| / ||J^T lambda|| at the end
+  // Natural-map residual ||lambda - Proj_K(lambda - w)||_inf of the last QP at exit (PGS, after
+  // any projected-Newton polish; MATH.md §5) [units of lambda and w].
+  double lcp_residual = 0.0;
   bool converged = true;          // violation within tolerance at the end (false: caps reached)
 
   int islands = 0;                // islands solved by the SQP (with at least one row source)
