@@ -2,7 +2,6 @@
 
 #include <algorithm>
 
-
 namespace taut {
 
 void ImplicitSystem::Build(const ElementModel& model, const std::vector<NodeKind>& kinds) {
@@ -58,13 +57,18 @@ void ImplicitSystem::Build(const ElementModel& model, const std::vector<NodeKind
             map[3 * c + r] = (row >= 0 && col >= 0) ? index_of(row, col) : -1;
           }
   }
-  if (n > 0) ldlt_.Analyze(A_);
+  // Backend by size (see the class comment); the other one is emptied to free its memory.
+  use_cholmod_ = requested_solver_ == LinearSolverKind::kCholmod ||
+                 (requested_solver_ == LinearSolverKind::kAuto && n >= kCholmodMinFreeDofs);
+  ldlt_ = SparseLdlt();
+  cholmod_ = CholmodCholesky();
+  if (n > 0 && use_cholmod_) cholmod_.Analyze(A_);
+  if (n > 0 && !use_cholmod_) ldlt_.Analyze(A_);
   rhs_free_.resize(n);
   product_free_.resize(n);
 }
 
-void ImplicitSystem::Assemble(const ElementModel& model, const VecX& mass, double c_M,
-                              double c_K) {
+void ImplicitSystem::Assemble(const ElementModel& model, const VecX& mass, double c_M, double c_K) {
   double* values = A_.valuePtr();
   std::fill(values, values + A_.nonZeros(), 0.0);
   for (int i = 0; i < num_free_dofs(); ++i) values[diagonal_[i]] += c_M * mass[free_to_dof_[i] / 3];
@@ -73,7 +77,9 @@ void ImplicitSystem::Assemble(const ElementModel& model, const VecX& mass, doubl
 
 void ImplicitSystem::Factor(const std::string& body) {
   if (num_free_dofs() == 0) return;
-  if (!ldlt_.Factorize(A_) || ldlt_.num_negative_pivots() > 0)
+  const bool ok = use_cholmod_ ? cholmod_.Factorize(A_)
+                               : ldlt_.Factorize(A_) && ldlt_.num_negative_pivots() == 0;
+  if (!ok)
     throw SimulationError(internal::Concat("body '", body,
                                            "': system matrix A = M + hD + h^2 K is not positive "
                                            "definite (stage: factorization)"));
@@ -84,7 +90,10 @@ void ImplicitSystem::Solve(Eigen::Ref<VecX> rhs) const {
   for (int i = 0; i < n; ++i) rhs_free_[i] = rhs[free_to_dof_[i]];
   rhs.setZero();
   if (n == 0) return;
-  ldlt_.Solve(rhs_free_);
+  if (use_cholmod_)
+    cholmod_.Solve(rhs_free_);
+  else
+    ldlt_.Solve(rhs_free_);
   for (int i = 0; i < n; ++i) rhs[free_to_dof_[i]] = rhs_free_[i];
 }
 
@@ -96,7 +105,10 @@ void ImplicitSystem::SolveColumns(Eigen::Ref<MatX> rhs) const {
   for (int i = 0; i < n; ++i) cols.row(i) = rhs.row(free_to_dof_[i]);
   rhs.setZero();
   if (n == 0) return;
-  ldlt_.SolveColumns(cols);
+  if (use_cholmod_)
+    cholmod_.SolveColumns(cols);
+  else
+    ldlt_.SolveColumns(cols);
   for (int i = 0; i < n; ++i) rhs.row(free_to_dof_[i]) = cols.row(i);
 }
 

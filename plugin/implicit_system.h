@@ -4,18 +4,41 @@
 #include <Eigen/SparseCore>
 #include <vector>
 
+#include "plugin/cholmod_cholesky.h"
 #include "plugin/element_model.h"
 #include "plugin/node_kind.h"
 #include "plugin/sparse_ldlt.h"
 
 namespace taut {
 
+// Which sparse factorization an ImplicitSystem uses.
+enum class LinearSolverKind {
+  kAuto,        // SparseLdlt below ImplicitSystem::kCholmodMinFreeDofs free DOFs, else CHOLMOD
+  kSparseLdlt,  // always the allocation-free scalar LDL^T (plugin/sparse_ldlt.h)
+  kCholmod,     // always CHOLMOD's supernodal LL^T (plugin/cholmod_cholesky.h)
+};
+
 // Symbolic structure built once per body (and again only when nodes are fixed or released):
 // the free-DOF numbering, the full symmetric CSC pattern of A, the element -> value index map
-// and the LDL^T analysis. Each step then writes values through the map (no setFromTriplets,
-// no allocation) and refactors numerically.
+// and the factorization's analysis. Each step then writes values through the map (no
+// setFromTriplets, no allocation) and refactors numerically.
+//
+// Backend by size (kAuto): the scalar up-looking SparseLdlt never touches the heap after Build, but
+// its flops grow like n^2 on 3D meshes and run one scalar at a time; CHOLMOD's supernodal
+// factorization runs them as dense BLAS-3 blocks but allocates inside every Factor. Factor + solve,
+// CHOLMOD vs SparseLdlt (bench/factorization_bench.cc, serial OpenBLAS): break-even near 400 free
+// DOFs on tet beams (250 on hex balls), 1.3x at 500, 2x at 900, 5.6x at 1.9k (armadillo-sized
+// hexes), 6.4x at 12.6k, 40x at 58k. So a step of a body with fewer than kCholmodMinFreeDofs free
+// DOFs makes no heap allocation, and a larger body's step allocates a few buffers inside Factor
+// (none in the solves).
 class ImplicitSystem {
  public:
+  // Free-DOF count from which kAuto picks CHOLMOD: the measured crossover of factor + solve
+  // (bench/factorization_bench.cc), rounded up; smaller bodies keep allocation-free steps.
+  static constexpr int kCholmodMinFreeDofs = 500;
+
+  // Chooses the backend for the next Build (default kAuto).
+  void set_linear_solver(LinearSolverKind kind) { requested_solver_ = kind; }
   // Builds the pattern for the model's connectivity with the given node kinds.
   void Build(const ElementModel& model, const std::vector<NodeKind>& kinds);
   // A = c_M diag(mass) + c_K K(rotations of the model's last update), on free DOFs.
@@ -34,6 +57,8 @@ class ImplicitSystem {
   // Free index of a DOF (3 node + axis), or -1 when fixed or kinematic.
   int free_index(int dof) const { return dof_to_free_[dof]; }
   const Eigen::SparseMatrix<double>& matrix() const { return A_; }
+  // True when the last Build chose CHOLMOD.
+  bool uses_cholmod() const { return use_cholmod_; }
 
  private:
   std::vector<int> dof_to_free_;   // (3N) free index or -1
@@ -41,7 +66,10 @@ class ImplicitSystem {
   std::vector<int> diagonal_;      // (num_free) value index of A(i,i)
   std::vector<int> element_map_;   // (num_elements x k^2 x 9) value index or -1
   Eigen::SparseMatrix<double> A_;  // full symmetric, free DOFs
-  SparseLdlt ldlt_;
+  LinearSolverKind requested_solver_ = LinearSolverKind::kAuto;
+  bool use_cholmod_ = false;
+  SparseLdlt ldlt_;          // the factor when !use_cholmod_
+  CholmodCholesky cholmod_;  // the factor when use_cholmod_
   mutable VecX rhs_free_;
   mutable MatX columns_free_;
   mutable VecX product_free_;

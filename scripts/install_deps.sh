@@ -21,6 +21,8 @@ PACKAGES=(
   libfcl-dev
   libccd-dev
   libtinyobjloader-dev
+  libsuitesparse-dev
+  libopenblas0-serial
   libstb-dev
   gnuplot-nox
   clang

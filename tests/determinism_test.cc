@@ -1,5 +1,7 @@
 // Every demo scene is deterministic: two runs give bitwise identical state hashes, and the hashes
 // are pinned (tests/data/determinism_hashes.txt) so an unintended change of results shows up.
+// Scenes with bodies large enough for the CHOLMOD backend are marked "-" there: their last bits
+// depend on the BLAS kernels OpenBLAS picks for the CPU, so only run-to-run equality is checked.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -58,6 +60,7 @@ TEST(DeterminismTest, EverySceneRunTwiceGivesTheSameStateHashAndMatchesItsPin) {
     // Pins hold for the Release build on Debian 12 (GCC 12, Eigen 3.4, Bullet 3.24 float64);
     // sanitizer builds compile with other optimizations and only check run-to-run equality.
     const auto it = pinned.find(info.name);
+    if (it != pinned.end() && it->second == "-") continue;  // BLAS-dependent: equality only
     if (it == pinned.end()) {
       ADD_FAILURE() << info.name << ": no pinned hash; add '" << info.name << " " << hex
                     << "' to tests/data/determinism_hashes.txt";
