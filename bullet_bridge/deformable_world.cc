@@ -70,13 +70,10 @@ DeformableBody* DeformableWorld::AddDeformableBody(std::unique_ptr<DeformableBod
   entry->object = std::make_unique<DeformableCollisionObject>(std::move(body));
   entry->island_body = std::make_unique<DeformableIslandBody>(entry->object->body());
   DeformableBody& added = entry->object->body();
-  entry->contacts = std::make_unique<RigidContactSource>(
-      added, next_source_id_++, added.settings().friction, added.settings().contact_margin);
-  if (const auto* tets = dynamic_cast<const TetElementModel*>(&added.model())) {
-    entry->surface = MakeTetContactSurface(tets->mesh());
-  } else if (const auto* hexes = dynamic_cast<const HexElementModel*>(&added.model())) {
-    entry->surface = MakeHexContactSurface(hexes->lattice());
-  }
+  entry->surface = MakeBodyContactSurface(added.model());
+  entry->contacts = std::make_unique<RigidContactSource>(added, entry->surface, next_source_id_++,
+                                                         added.settings().friction,
+                                                         added.settings().contact_margin);
   bodies_.push_back(std::move(entry));
   addCollisionObject(&bodies_.back()->collision_object(), btBroadphaseProxy::DefaultFilter,
                      btBroadphaseProxy::AllFilter);

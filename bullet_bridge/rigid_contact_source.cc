@@ -11,33 +11,9 @@
 
 namespace taut {
 
-namespace {
-// The body's own boundary: tet boundary vertices, hex lattice boundary corners.
-ContactSurface MakeBoundarySurface(const DeformableBody& body) {
-  if (const auto* tets = dynamic_cast<const TetElementModel*>(&body.model()))
-    return MakeTetContactSurface(tets->mesh());
-  if (const auto* hexes = dynamic_cast<const HexElementModel*>(&body.model()))
-    return MakeHexContactSurface(hexes->lattice());
-  ContactSurface all;
-  for (int i = 0; i < body.num_nodes(); ++i) {
-    ContactPoint p;
-    p.num_nodes = 1;
-    p.nodes[0] = i;
-    p.weights[0] = 1.0;
-    all.points.push_back(p);
-  }
-  return all;
-}
 
-// Two unit tangents orthogonal to n.
-void CalcTangents(const Vec3& n, Vec3& t1, Vec3& t2) {
-  t1 = (std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized();
-  t2 = n.cross(t1);
-}
-}  // namespace
-
-RigidContactSource::RigidContactSource(const DeformableBody& body, int source_id, double friction,
-                                       double margin)
+RigidContactSource::RigidContactSource(const DeformableBody& body, const ContactSurface& surface,
+                                       int source_id, double friction, double margin)
     : body_(body),
       key_prefix_(static_cast<std::uint64_t>(source_id) << 48),
       friction_(friction),
@@ -46,7 +22,7 @@ RigidContactSource::RigidContactSource(const DeformableBody& body, int source_id
               "': contact friction must be finite and >= 0, got ", friction);
   TAUT_DEMAND(std::isfinite(margin) && margin > 0.0, "body '", body.name(),
               "': contact margin must be finite and > 0 m, got ", margin);
-  set_surface(MakeBoundarySurface(body));
+  set_surface(surface);
 }
 
 bool RigidContactSource::Moves(const ContactPoint& point) const {
@@ -102,7 +78,7 @@ int RigidContactSource::AppendIslandRows(const IslandIterate& iterate,
       // its side is J_lin = -d, J_ang = -(q - com) x d for each direction d.
       Vec3 d[3];
       d[0] = contact.normal;
-      CalcTangents(contact.normal, d[1], d[2]);
+      CalcContactTangents(contact.normal, d[1], d[2]);
       const Vec3 r = p - contact.gap * contact.normal - com;
       const std::uint64_t key =
           key_prefix_ | ((static_cast<std::uint64_t>(i) * 4096 + object_id) * 3);

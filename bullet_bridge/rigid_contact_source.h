@@ -24,8 +24,9 @@ class RigidContactSource final : public ConstraintSource {
  public:
   // `friction` is the body's Coulomb coefficient, combined with each object's by the product
   // (Bullet's default combiner); `margin` [m] is how close a point must be to get rows. The
-  // contact points are the body's boundary (MakeTetContactSurface / MakeHexContactSurface).
-  RigidContactSource(const DeformableBody& body, int source_id, double friction, double margin);
+  // contact points are those of `surface` (usually MakeBodyContactSurface(body.model())).
+  RigidContactSource(const DeformableBody& body, const ContactSurface& surface, int source_id,
+                     double friction, double margin);
 
   // Replaces the contact points (e.g. a surface embedded in a hex body: 8-node rows). Points
   // whose nodes are all fixed or kinematic get no rows.

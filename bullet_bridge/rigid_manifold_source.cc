@@ -39,10 +39,7 @@ void RigidManifoldSource::AddManifold(const btPersistentManifold& manifold,
     p.ra = ToEigen(point.getPositionWorldOnA()) - com_a;
     p.rb = ToEigen(point.getPositionWorldOnB()) - com_b;
     p.normal = ToEigen(point.m_normalWorldOnB).normalized();
-    p.tangent[0] = (std::abs(p.normal.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY())
-                       .cross(p.normal)
-                       .normalized();
-    p.tangent[1] = p.normal.cross(p.tangent[0]);
+    CalcContactTangents(p.normal, p.tangent[0], p.tangent[1]);
     p.distance = static_cast<double>(point.getDistance());
     p.friction = static_cast<double>(point.m_combinedFriction);
     // Approach speed at v* (Bullet's solver also measures it after external impulses).

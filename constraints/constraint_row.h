@@ -66,6 +66,13 @@ struct ConstraintRow {
   }
 };
 
+// Two unit tangents t1, t2 completing the unit normal n to a right-handed frame (n, t1, t2 = n x t1):
+// the friction directions of a contact (MATH.md §5).
+inline void CalcContactTangents(const Vec3& n, Vec3& t1, Vec3& t2) {
+  t1 = (std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized();
+  t2 = n.cross(t1);
+}
+
 // Anything that emits rows for an island (limits, contacts, joints), evaluated at an iterate.
 class ConstraintSource {
  public:

@@ -42,12 +42,6 @@ Vec3 CalcNearestTrianglePoint(const Vec3& p, const Vec3& a, const Vec3& b, const
 }  // namespace internal
 
 namespace {
-// Two unit tangents orthogonal to n.
-void CalcTangents(const Vec3& n, Vec3& t1, Vec3& t2) {
-  t1 = (std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized();
-  t2 = n.cross(t1);
-}
-
 // Node of a triangle corner (node triangles: every corner point is one node).
 int CornerNode(const ContactSurface& surface, int triangle, int corner) {
   return surface.points[surface.triangles[triangle][corner]].nodes[0];
@@ -141,7 +135,7 @@ int DeformableContactSource::AppendIslandRows(const IslandIterate& iterate,
     const ContactPoint& point = points.points[hit.point];
     Vec3 d[3];
     d[0] = hit.normal;
-    CalcTangents(hit.normal, d[1], d[2]);
+    CalcContactTangents(hit.normal, d[1], d[2]);
     const std::uint64_t key =
         key_prefix_ | ((static_cast<std::uint64_t>(hit.point) * 2 + hit.direction) *
                            (std::uint64_t{1} << 20) +

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <map>
 
+#include "plugin/hex_element_model.h"
+#include "plugin/tet_element_model.h"
+
 namespace taut {
 
 namespace {
@@ -78,6 +81,16 @@ ContactSurface MakeEmbeddedContactSurface(const HexLattice& lattice,
   }
   result.triangles = surface.triangles;
   return result;
+}
+
+ContactSurface MakeBodyContactSurface(const ElementModel& model) {
+  if (const auto* tets = dynamic_cast<const TetElementModel*>(&model))
+    return MakeTetContactSurface(tets->mesh());
+  if (const auto* hexes = dynamic_cast<const HexElementModel*>(&model))
+    return MakeHexContactSurface(hexes->lattice());
+  ContactSurface all;
+  for (int i = 0; i < model.num_nodes(); ++i) all.points.push_back(NodePoint(i));
+  return all;
 }
 
 }  // namespace taut

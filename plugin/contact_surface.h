@@ -6,6 +6,7 @@
 #include <array>
 #include <vector>
 
+#include "plugin/element_model.h"
 #include "plugin/embedded_surface.h"
 #include "plugin/hex_lattice.h"
 #include "plugin/tet_mesh.h"
@@ -35,6 +36,10 @@ ContactSurface MakeHexContactSurface(const HexLattice& lattice);
 // The vertices and triangles of a surface embedded in the lattice (8-node points).
 ContactSurface MakeEmbeddedContactSurface(const HexLattice& lattice,
                                           const EmbeddedSurface& surface);
+
+// The boundary of a tet or hex body's model (the two functions above); every node for other
+// models (points without triangles).
+ContactSurface MakeBodyContactSurface(const ElementModel& model);
 
 // Position of point p for node positions x (3N).
 inline Vec3 CalcContactPointPosition(const ContactPoint& p, const VecX& x) {

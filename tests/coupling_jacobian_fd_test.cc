@@ -87,7 +87,7 @@ TEST(CouplingJacobianFdTest, NodeAgainstDynamicRigidBoxMatchesCentralDifferences
   btRigidBody rigid(2.0, &state, &shape, inertia);
   RigidIslandBody box(&rigid);
   box.BeginStep(kH);
-  RigidContactSource source(*cube, 1, 0.5, 0.05);
+  RigidContactSource source(*cube, MakeBodyContactSurface(cube->model()), 1, 0.5, 0.05);
   source.set_partners({{&rigid, &box}});
   DeformableIslandBody flesh(*cube);
   const std::vector<IslandBody*> bodies = {&flesh, &box};
