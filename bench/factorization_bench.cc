@@ -1,16 +1,23 @@
-// SparseLdlt vs CholmodCholesky on real implicit-step matrices A = M + h^2 K (co-rotated K of a
+// Sparse factorization backends on real implicit-step matrices A = M + h^2 K (co-rotated K of a
 // twisted body, free DOFs only, h = 1/240 s): the tet beams of tet_scaling_bench.cc (1 x 0.2 x
-// 0.2 m, E = 200 kPa, x = 0 end fixed) and free hex balls of armadillo size (E = 500 kPa).
-// Each benchmark times CHOLMOD (manual time: Time column, cholmod_ms = median) and, in the same
-// run, SparseLdlt on the same matrix (ldlt_ms: median of up to 5 runs within ~1 s), and reports
-// speedup = ldlt_ms / cholmod_ms and the relative difference of the two solutions.
-// ImplicitSystem::kCholmodMinFreeDofs is the crossover of BM_FactorSolve.
+// 0.2 m, E = 200 kPa, x = 0 end fixed), free hex balls of armadillo size (E = 500 kPa) and, when
+// data/armadillo.off is present (scripts/fetch_armadillo.sh), the armadillo scene's 368-hex
+// lattice. Backends, each its own benchmark BM_Factorization/<op>/<case>/<backend> (manual time,
+// median of the repetitions in the Time column):
+//   ldlt        SparseLdlt (taut's up-looking LDL^T, AMD ordering): the default build's backend
+//   eigen_llt   Eigen's SimplicialLLT (AMD ordering)
+//   cholmod     CHOLMOD's supernodal LL^T (only in builds with -DTAUT_WITH_CHOLMOD=ON, GPL-2+)
+// op: factor_solve (numeric factorization + one solve, what every step does) or solve64 (64
+// right-hand sides, the A^-1 J^T columns). Counters: dofs, elements, nnz_L (entries of L), and
+// rel_diff, the relative difference of the solution to ldlt's.
 //   taut_bench --benchmark_filter=BM_Factorization
 #include <benchmark/benchmark.h>
 
+#include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <memory>
 #include <random>
@@ -23,8 +30,11 @@
 #include "plugin/cholmod_cholesky.h"
 #include "plugin/hex_element_model.h"
 #include "plugin/hex_shapes.h"
+#include "plugin/hex_voxelizer.h"
 #include "plugin/implicit_system.h"
+#include "plugin/off_reader.h"
 #include "plugin/sparse_ldlt.h"
+#include "plugin/surface_mesh.h"
 #include "plugin/tet_element_model.h"
 
 namespace taut {
@@ -32,14 +42,33 @@ namespace {
 
 using SparseMatrix = SparseLdlt::SparseMatrix;
 
-// A body shape: a tet beam of (n0 x n1 x n2) box cells, or a hex ball n0 cells across.
+// A body shape: a tet beam of (n0 x n1 x n2) box cells, a hex ball n0 cells across, or (armadillo)
+// the armadillo scene's lattice.
 struct CaseSpec {
   bool hex_ball;
   int n0, n1, n2;
+  bool armadillo = false;
   bool operator<(const CaseSpec& o) const {
-    return std::tie(hex_ball, n0, n1, n2) < std::tie(o.hex_ball, o.n0, o.n1, o.n2);
+    return std::tie(hex_ball, n0, n1, n2, armadillo) <
+           std::tie(o.hex_ball, o.n0, o.n1, o.n2, o.armadillo);
   }
 };
+
+// The armadillo scan as the armadillo scene voxelizes it: 2 m tall, cells of 0.1145 m (368 hexes).
+std::string ArmadilloPath() {
+  return (std::filesystem::path(__FILE__).parent_path().parent_path() / "data" / "armadillo.off")
+      .string();
+}
+HexLattice MakeArmadilloLattice() {
+  SurfaceMesh scan = ReadOffSurface(ArmadilloPath());
+  const Eigen::AlignedBox3d bounds = CalcSurfaceBounds(scan);
+  const double scale = 2.0 / bounds.sizes().y();
+  for (Vec3& v : scan.vertices) {
+    const Vec3 u = (v - bounds.min()) * scale;
+    v = Vec3(u.x(), -u.z(), u.y());
+  }
+  return VoxelizeSurface(scan, 0.1145);
+}
 
 // The system matrix of one body and right-hand sides.
 struct FemCase {
@@ -53,9 +82,10 @@ struct FemCase {
 std::unique_ptr<ElementModel> MakeModel(const CaseSpec& spec, std::vector<NodeKind>& kinds,
                                         double& density) {
   std::unique_ptr<ElementModel> model;
-  if (spec.hex_ball) {
+  if (spec.hex_ball || spec.armadillo) {
     density = 500.0;
-    auto lattice = std::make_shared<HexLattice>(MakeSphereHexLattice(1.0, 2.0 / spec.n0));
+    auto lattice = std::make_shared<HexLattice>(
+        spec.armadillo ? MakeArmadilloLattice() : MakeSphereHexLattice(1.0, 2.0 / spec.n0));
     model = std::make_unique<HexElementModel>(lattice, Material{500e3, 0.3, density});
   } else {
     density = 1000.0;
@@ -65,7 +95,8 @@ std::unique_ptr<ElementModel> MakeModel(const CaseSpec& spec, std::vector<NodeKi
   }
   kinds.assign(model->num_nodes(), NodeKind::kFree);
   for (int i = 0; i < model->num_nodes(); ++i)
-    if (!spec.hex_ball && model->rest_positions()[3 * i] < 1e-9) kinds[i] = NodeKind::kFixed;
+    if (!spec.hex_ball && !spec.armadillo && model->rest_positions()[3 * i] < 1e-9)
+      kinds[i] = NodeKind::kFixed;
   return model;
 }
 
@@ -106,12 +137,6 @@ double Now() {
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
 }
 
-// Median of the values (copied).
-double CalcMedian(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
 // What a benchmark times.
 enum class Op { kFactorSolve, kSolve64 };
 
@@ -129,69 +154,124 @@ void RunOp(Solver& solver, const FemCase& c, Op op, VecX& x, MatX& X) {
   }
 }
 
-// Times CHOLMOD in the loop and SparseLdlt once per call; reports the ratio.
-void BM_Factor(benchmark::State& state, Op op, CaseSpec spec) {
-  const FemCase& c = GetCase(spec);
+// Eigen's SimplicialLLT (AMD) behind the Analyze / Factorize / Solve / SolveColumns interface.
+class EigenLlt {
+ public:
+  void Analyze(const SparseMatrix& A) { llt_.analyzePattern(A); }
+  bool Factorize(const SparseMatrix& A) {
+    llt_.factorize(A);
+    return llt_.info() == Eigen::Success;
+  }
+  void Solve(VecX& x) const { x = llt_.solve(x); }
+  void SolveColumns(MatX& X) const { X = llt_.solve(X); }
+  double nonzeros_in_L() const {
+    return static_cast<double>(llt_.matrixL().nestedExpression().nonZeros());
+  }
+
+ private:
+  Eigen::SimplicialLLT<SparseMatrix, Eigen::Upper> llt_;
+};
+
+// Entries of L of each backend (CHOLMOD: stored supernodal entries).
+double EntriesOfL(const SparseLdlt& s) { return s.nonzeros_in_L(); }
+double EntriesOfL(const CholmodCholesky& s) { return s.stored_entries_in_L(); }
+double EntriesOfL(const EigenLlt& s) { return s.nonzeros_in_L(); }
+
+// SparseLdlt's solution of the case (the reference of rel_diff), computed once per case and op.
+const MatX& ReferenceSolution(const CaseSpec& spec, const FemCase& c, Op op) {
+  static std::map<std::pair<CaseSpec, int>, MatX> refs;
+  auto key = std::make_pair(spec, static_cast<int>(op));
+  auto found = refs.find(key);
+  if (found != refs.end()) return found->second;
   SparseLdlt ldlt;
   ldlt.Analyze(c.A);
-  CholmodCholesky cholmod;
-  cholmod.Analyze(c.A);
-  VecX x_ldlt, x_chol;
-  MatX X_ldlt, X_chol;
-  if (op == Op::kSolve64) {
-    ldlt.Factorize(c.A);
-    cholmod.Factorize(c.A);
-  }
-  std::vector<double> ldlt_s;
-  for (double start = Now(); ldlt_s.size() < 5 && (ldlt_s.empty() || Now() - start < 1.0);) {
-    const double t0 = Now();
-    RunOp(ldlt, c, op, x_ldlt, X_ldlt);
-    ldlt_s.push_back(Now() - t0);
-  }
-  std::vector<double> cholmod_s;
+  VecX x;
+  MatX X;
+  if (op == Op::kSolve64) ldlt.Factorize(c.A);
+  RunOp(ldlt, c, op, x, X);
+  return refs[key] = op == Op::kFactorSolve ? MatX(x) : X;
+}
+
+// Times one backend (analysis outside the loop).
+template <class Solver>
+void RunBackend(benchmark::State& state, Solver& solver, Op op, const CaseSpec& spec) {
+  const FemCase& c = GetCase(spec);
+  const MatX& ref = ReferenceSolution(spec, c, op);
+  solver.Analyze(c.A);
+  if (op == Op::kSolve64 && !solver.Factorize(c.A)) throw SimulationError("factorization failed");
+  VecX x;
+  MatX X;
   for (auto _ : state) {
     const double t0 = Now();
-    RunOp(cholmod, c, op, x_chol, X_chol);
-    cholmod_s.push_back(Now() - t0);
-    state.SetIterationTime(cholmod_s.back());
+    RunOp(solver, c, op, x, X);
+    state.SetIterationTime(Now() - t0);
   }
-  const double diff = op == Op::kFactorSolve ? (x_chol - x_ldlt).norm() / x_ldlt.norm()
-                                             : (X_chol - X_ldlt).norm() / X_ldlt.norm();
+  const double diff =
+      op == Op::kFactorSolve ? (x - ref.col(0)).norm() / ref.norm() : (X - ref).norm() / ref.norm();
   state.counters["dofs"] = static_cast<double>(c.A.rows());
   state.counters["elements"] = c.elements;
-  state.counters["ldlt_ms"] = 1e3 * CalcMedian(ldlt_s);
-  state.counters["cholmod_ms"] = 1e3 * CalcMedian(cholmod_s);
-  state.counters["speedup"] = CalcMedian(ldlt_s) / CalcMedian(cholmod_s);
-  state.counters["nnz_L_ldlt"] = ldlt.nonzeros_in_L();
-  state.counters["stored_L_cholmod"] = cholmod.stored_entries_in_L();
-  state.counters["supernodes"] = cholmod.num_supernodes();
+  state.counters["nnz_L"] = EntriesOfL(solver);
   state.counters["rel_diff"] = diff;
 }
 
-// Registers both operations on tet beams (cells, aspect ~5) of ~200, 300, 500, 1k, 2k, 5k, 20k and
-// 100k tets and hex balls of 4, 5, 7, 9 and 12 cells across (9 is the armadillo's 368-hex size).
+// The backends.
+enum class Backend { kLdlt, kEigenLlt, kCholmod };
+
+void BM_Factor(benchmark::State& state, Op op, CaseSpec spec, Backend backend) {
+  switch (backend) {
+    case Backend::kLdlt: {
+      SparseLdlt s;
+      RunBackend(state, s, op, spec);
+      break;
+    }
+    case Backend::kEigenLlt: {
+      EigenLlt s;
+      RunBackend(state, s, op, spec);
+      break;
+    }
+    case Backend::kCholmod: {
+      CholmodCholesky s;
+      RunBackend(state, s, op, spec);
+      break;
+    }
+  }
+}
+
+// Registers both operations on tet beams (cells, aspect ~5) of ~200, 300, 500, 1k, 2k, 5k, 20k,
+// 25k and 100k tets, hex balls of 4, 5, 7, 9 and 12 cells across (9 is the armadillo's 368-hex
+// size) and the armadillo itself (when its scan is present), for every backend of this build.
 const bool kRegistered = [] {
   struct NamedCase {
     const char* name;
     CaseSpec spec;
   };
-  const NamedCase cases[] = {
+  std::vector<NamedCase> cases = {
       {"tet_200", {false, 8, 2, 2}},     {"tet_300", {false, 12, 2, 2}},
       {"tet_500", {false, 14, 2, 3}},    {"tet_1k", {false, 19, 3, 3}},
       {"tet_2k", {false, 23, 4, 4}},     {"tet_5k", {false, 33, 5, 5}},
-      {"tet_20k", {false, 52, 8, 8}},    {"tet_100k", {false, 76, 15, 15}},
-      {"hex_ball_4", {true, 4, 0, 0}},   {"hex_ball_5", {true, 5, 0, 0}},
-      {"hex_ball_7", {true, 7, 0, 0}},   {"hex_ball_9", {true, 9, 0, 0}},
-      {"hex_ball_12", {true, 12, 0, 0}},
+      {"tet_20k", {false, 52, 8, 8}},    {"tet_25k", {false, 65, 8, 8}},
+      {"tet_100k", {false, 76, 15, 15}}, {"hex_ball_4", {true, 4, 0, 0}},
+      {"hex_ball_5", {true, 5, 0, 0}},   {"hex_ball_7", {true, 7, 0, 0}},
+      {"hex_ball_9", {true, 9, 0, 0}},   {"hex_ball_12", {true, 12, 0, 0}},
   };
+  if (std::filesystem::exists(ArmadilloPath()))
+    cases.push_back({"armadillo", {false, 0, 0, 0, true}});
+  std::vector<std::pair<Backend, const char*>> backends = {{Backend::kLdlt, "ldlt"},
+                                                           {Backend::kEigenLlt, "eigen_llt"}};
+  if (IsCholmodAvailable()) backends.push_back({Backend::kCholmod, "cholmod"});
   for (const auto& [op, op_name] :
        {std::pair{Op::kFactorSolve, "factor_solve"}, std::pair{Op::kSolve64, "solve64"}})
     for (const NamedCase& c : cases)
-      benchmark::RegisterBenchmark(
-          (std::string("BM_Factorization/") + op_name + "/" + c.name).c_str(), BM_Factor, op,
-          c.spec)
-          ->UseManualTime()
-          ->Unit(benchmark::kMillisecond);
+      for (const auto& [backend, backend_name] : backends) {
+        // 100k tets: the simplicial backends take ~20 s per factorization; SparseLdlt only.
+        if (std::string(c.name) == "tet_100k" && backend == Backend::kEigenLlt) continue;
+        benchmark::RegisterBenchmark(
+            (std::string("BM_Factorization/") + op_name + "/" + c.name + "/" + backend_name)
+                .c_str(),
+            BM_Factor, op, c.spec, backend)
+            ->UseManualTime()
+            ->Unit(benchmark::kMillisecond);
+      }
   return true;
 }();
 

@@ -422,6 +422,18 @@ void DeformableWorld::AccumulateStats(const StepStats& island_stats) {
   stats_.violation_before = std::max(stats_.violation_before, island_stats.violation_before);
   stats_.violation_after = std::max(stats_.violation_after, island_stats.violation_after);
   stats_.converged = stats_.converged && island_stats.converged;
+  stats_.islands_dual += island_stats.islands_dual;
+  stats_.islands_primal += island_stats.islands_primal;
+  stats_.newton_iterations += island_stats.newton_iterations;
+  stats_.pcg_iterations += island_stats.pcg_iterations;
+  stats_.kkt_primal = std::max(stats_.kkt_primal, island_stats.kkt_primal);
+  stats_.kkt_complementarity = std::max(stats_.kkt_complementarity, island_stats.kkt_complementarity);
+  stats_.kkt_dual = std::max(stats_.kkt_dual, island_stats.kkt_dual);
+  for (int i = 0; i < 5; ++i) {
+    stats_.kkt_primal_by_type[i] = std::max(stats_.kkt_primal_by_type[i], island_stats.kkt_primal_by_type[i]);
+    stats_.kkt_complementarity_by_type[i] =
+        std::max(stats_.kkt_complementarity_by_type[i], island_stats.kkt_complementarity_by_type[i]);
+  }
 }
 
 void DeformableWorld::solveConstraints(btContactSolverInfo& info) {

@@ -19,7 +19,7 @@
 #include "constraints/deformable_island_body.h"
 #include "constraints/union_find.h"
 #include "constraints/energy_limit_constraint.h"
-#include "constraints/sqp_solver.h"
+#include "constraints/island_solver.h"
 #include "constraints/step_stats.h"
 #include "constraints/strain_limit_constraint.h"
 #include "plugin/hex_element_model.h"
@@ -117,7 +117,7 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
     std::vector<ContactPartner> partners;  // this step
     ContactSurface surface;                // contact points and triangles
     Vec3 swept_lo, swept_hi;               // bounds of this step's motion, grown by the margin
-    SqpSolver solver;
+    IslandSolver solver;
     int island = -1;  // this step
     DeformableBody& body() { return object->body(); }
     btCollisionObject& collision_object() { return object->collision_object(); }

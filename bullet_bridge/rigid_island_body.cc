@@ -82,6 +82,29 @@ void RigidIslandBody::ApplySystemMatrix(const VecX& v, VecX& out) const {
   out.tail<3>() = inertia_ * v.tail<3>();
 }
 
+double RigidIslandBody::CalcBlockMobility(int i, const Vec3& J) const {
+  VecX column = VecX::Zero(6);
+  column.segment<3>(3 * i) = J;
+  SolveSystemColumns(column);
+  return J.dot(column.segment<3>(3 * i));
+}
+
+void RigidIslandBody::FactorNewtonMatrix() {
+  mobility_.setIdentity();
+  SolveSystemColumns(mobility_);
+  newton_lu_.compute(Eigen::Matrix<double, 6, 6>::Identity() + mobility_ * newton_added_);
+}
+
+void RigidIslandBody::SolveNewton(Eigen::Ref<VecX> rhs) const {
+  const Eigen::Matrix<double, 6, 1> mobile = mobility_ * rhs.head<6>();
+  rhs.head<6>() = newton_lu_.solve(mobile);
+}
+
+void RigidIslandBody::ApplyNewtonMatrix(const VecX& v, VecX& out) const {
+  ApplySystemMatrix(v, out);
+  out += newton_added_ * v.head<6>();
+}
+
 btTransform RigidIslandBody::PredictTransform(double h, const VecX& v) const {
   btTransform predicted;
   btTransformUtil::integrateTransform(start_, ToBullet(Vec3(v.head<3>())),

@@ -4,6 +4,8 @@
 
 #include <BulletDynamics/Dynamics/btRigidBody.h>
 
+#include <Eigen/LU>
+
 #include "constraints/island_body.h"
 
 namespace taut {
@@ -34,6 +36,17 @@ class RigidIslandBody final : public IslandBody {
   void ApplySystemMatrix(const VecX& v, VecX& out) const override;
   bool is_free_block(int /*i*/) const override { return true; }
   void CalcPositions(double /*h*/, const VecX& /*v*/, VecX& x) const override { x.resize(0); }
+  double CalcBlockMobility(int i, const Vec3& J) const override;
+  // Newton matrix H = A + B (B: the 6x6 blocks added), solved in mobility form
+  // d = (I + A^+ B)^-1 A^+ rhs so locked axes (Bullet's linear/angular factors) stay at rest.
+  void ResetNewtonMatrix() override { newton_added_.setZero(); }
+  bool IsInNewtonPattern(int /*i*/, int /*j*/) const override { return true; }
+  void AddNewtonBlock(int i, int j, const Mat3& block) override {
+    newton_added_.block<3, 3>(3 * i, 3 * j) += block;
+  }
+  void FactorNewtonMatrix() override;
+  void SolveNewton(Eigen::Ref<VecX> rhs) const override;
+  void ApplyNewtonMatrix(const VecX& v, VecX& out) const override;
 
   // Transform after a step h at velocity v = [lin; ang] (Bullet's exponential-map integrator).
   btTransform PredictTransform(double h, const VecX& v) const;
@@ -49,6 +62,9 @@ class RigidIslandBody final : public IslandBody {
   VecX v_star_, v_;
   Mat3 inverse_inertia_;  // world frame, step start
   Mat3 inertia_;          // its pseudo-inverse
+  Eigen::Matrix<double, 6, 6> newton_added_ = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 6> mobility_;  // A^+ with the axis factors
+  Eigen::PartialPivLU<Eigen::Matrix<double, 6, 6>> newton_lu_;  // of I + A^+ B
 };
 
 }  // namespace taut

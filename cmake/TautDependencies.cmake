@@ -7,16 +7,20 @@ if(TAUT_BULLET_FLOAT)
 else()
   pkg_check_modules(BULLET REQUIRED IMPORTED_TARGET bullet-float64)
 endif()
-# CHOLMOD (SuiteSparse) for the supernodal Cholesky of large bodies (plugin/cholmod_cholesky.h).
+# CHOLMOD (SuiteSparse), only with -DTAUT_WITH_CHOLMOD=ON: the supernodal Cholesky of large bodies
+# (plugin/cholmod_cholesky.h). Its supernodal module is GPL-2+, so a build with it is GPL-bound;
+# the default build neither finds nor links it (README "License").
 # SuiteSparse >= 7 ships a CMake package with SuiteSparse::CHOLMOD; Debian 12's 5.12 ships only
 # the header (suitesparse/cholmod.h) and libcholmod.so, so the same target is made from them.
 # tautConfig.cmake.in repeats this for consumers of the installed package.
-find_package(CHOLMOD CONFIG QUIET)
-if(NOT TARGET SuiteSparse::CHOLMOD)
-  find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse REQUIRED)
-  find_library(CHOLMOD_LIBRARY cholmod REQUIRED)
-  add_library(SuiteSparse::CHOLMOD UNKNOWN IMPORTED)
-  set_target_properties(SuiteSparse::CHOLMOD PROPERTIES
-    IMPORTED_LOCATION ${CHOLMOD_LIBRARY}
-    INTERFACE_INCLUDE_DIRECTORIES ${CHOLMOD_INCLUDE_DIR})
+if(TAUT_WITH_CHOLMOD)
+  find_package(CHOLMOD CONFIG QUIET)
+  if(NOT TARGET SuiteSparse::CHOLMOD)
+    find_path(CHOLMOD_INCLUDE_DIR cholmod.h PATH_SUFFIXES suitesparse REQUIRED)
+    find_library(CHOLMOD_LIBRARY cholmod REQUIRED)
+    add_library(SuiteSparse::CHOLMOD UNKNOWN IMPORTED)
+    set_target_properties(SuiteSparse::CHOLMOD PROPERTIES
+      IMPORTED_LOCATION ${CHOLMOD_LIBRARY}
+      INTERFACE_INCLUDE_DIRECTORIES ${CHOLMOD_INCLUDE_DIR})
+  endif()
 endif()

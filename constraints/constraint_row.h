@@ -73,10 +73,29 @@ inline void CalcContactTangents(const Vec3& n, Vec3& t1, Vec3& t2) {
   t2 = n.cross(t1);
 }
 
+// Source id of a row key (bits 48-63; every source packs its id there).
+inline int RowKeySource(std::uint64_t key) { return static_cast<int>(key >> 48); }
+
+// Receives curvature blocks of rows for the SQP metric / Newton matrix (MATH.md §5 curvature):
+// blocks of weight * [-d^2 C / dx^2]_+ between two nodes of one deformable body.
+class CurvatureSink {
+ public:
+  virtual ~CurvatureSink() = default;
+  // metric(body; node_a, node_b) += block (3x3, dC^2/dx_a dx_b units times the weight).
+  virtual void AddBlock(int body, int node_a, int node_b, const Mat3& block) = 0;
+};
+
 // Anything that emits rows for an island (limits, contacts, joints), evaluated at an iterate.
 class ConstraintSource {
  public:
   virtual ~ConstraintSource() = default;
+  // Adds weights[c] * [-d^2 C_c/dx^2]_+ (negative curvature modes clamped to 0, so the sum stays
+  // positive semi-definite) for each of the `count` rows that this source emitted (matched by the
+  // key's source id), at the iterate. weights[c] >= 0 (h * lambda_c); rows of other sources and
+  // rows with weight 0 are skipped. Default: rows without curvature (contacts, joints: linear J).
+  virtual void AddIslandCurvature(const IslandIterate& /*iterate*/, const ConstraintRow* /*rows*/,
+                                  const double* /*weights*/, int /*count*/,
+                                  CurvatureSink& /*sink*/) const {}
   // Appends the rows active at the iterate (violated or within the activation margin). Returns
   // how many were appended.
   virtual int AppendIslandRows(const IslandIterate& iterate, std::vector<ConstraintRow>& rows) = 0;

@@ -26,6 +26,19 @@ class DeformableIslandBody final : public IslandBody {
     x = body_->x0() + h * v;
   }
   const DeformableBody* deformable() const override { return body_; }
+  double CalcBlockMobility(int i, const Vec3& J) const override {
+    return is_free_block(i) ? J.squaredNorm() / body_->mass()[i] : 0.0;
+  }
+  void ResetNewtonMatrix() override { body_->mutable_system().ResetNewtonMatrix(); }
+  bool IsInNewtonPattern(int i, int j) const override { return body_->system().IsInPattern(i, j); }
+  void AddNewtonBlock(int i, int j, const Mat3& block) override {
+    body_->mutable_system().AddNewtonBlock(i, j, block);
+  }
+  void FactorNewtonMatrix() override { body_->mutable_system().FactorNewtonMatrix(body_->name()); }
+  void SolveNewton(Eigen::Ref<VecX> rhs) const override { body_->system().SolveNewton(rhs); }
+  void ApplyNewtonMatrix(const VecX& v, VecX& out) const override {
+    body_->system().MultiplyNewton(v, out);
+  }
   DeformableBody& body() { return *body_; }
 
  private:

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "constraints/curvature_blocks.h"
+
 namespace taut {
 
 namespace {
@@ -39,6 +41,7 @@ EnergyLimitConstraint::EnergyLimitConstraint(const DeformableBody& body,
               " out of range");
   u_max_ = CalcElementEnergyLimits(settings_, GatherRestVolumes(tets_, hexes_));
   key_prefix_ = static_cast<std::uint64_t>(source_id) << 48;
+  source_id_ = source_id;
 }
 
 double EnergyLimitConstraint::CalcElementEnergy(const VecX& x, int e) const {
@@ -90,6 +93,28 @@ int EnergyLimitConstraint::AppendRows(const VecX& x, int body_index,
     FillRow(x, e, row);
   }
   return static_cast<int>(rows.size()) - before;
+}
+
+void EnergyLimitConstraint::AddIslandCurvature(const IslandIterate& iterate,
+                                               const ConstraintRow* rows, const double* weights,
+                                               int count, CurvatureSink& sink) const {
+  for (int c = 0; c < count; ++c) {
+    const ConstraintRow& row = rows[c];
+    if (RowKeySource(row.key) != source_id_ || !(weights[c] > 0.0)) continue;
+    const int e = static_cast<int>(RowKeyPayload(row.key));  // key = prefix | element
+    const VecX& x = iterate.x(row.body);
+    const int* nodes = body_.model().element_nodes(e);
+    if (tets_ != nullptr) {
+      const Mat12 H = CalcTetEnergyLimitCurvature(tets_->rest().elements[e], tets_->lame(),
+                                                  tets_->GatherElement(x, e), u_max_[e]);
+      AddElementCurvatureBlocks<4>(H, weights[c], row.body, nodes, sink);
+      continue;
+    }
+    const HexNodes xe = hexes_->GatherElement(x, e);
+    const Mat3 R = CalcHexRotation(hexes_->rest(e), xe, hexes_->rotation_method());
+    const Mat24 H = CalcHexEnergyLimitCurvature(hexes_->rest(e), R, u_max_[e]);
+    AddElementCurvatureBlocks<8>(H, weights[c], row.body, nodes, sink);
+  }
 }
 
 double EnergyLimitConstraint::CalcElementRatio(const VecX& x, int e) const {

@@ -25,6 +25,10 @@ class EnergyLimitConstraint final : public BodyConstraintSource {
   int AppendRows(const VecX& x, int body_index, std::vector<ConstraintRow>& rows) override;
   double CalcMaxViolation(const VecX& x) const override;
   double CalcViolationSum(const VecX& x) const override;
+  // Adds weights[c] K_e(R)/U_max,e (R frozen at the iterate; energy_limit_rows.h) for each row
+  // of this source, the element decoded from the key.
+  void AddIslandCurvature(const IslandIterate& iterate, const ConstraintRow* rows,
+                          const double* weights, int count, CurvatureSink& sink) const override;
 
   const EnergyLimitSettings& settings() const { return settings_; }
   // U_max,e of every element [J] (energy densities already multiplied by the rest volume).
@@ -46,6 +50,7 @@ class EnergyLimitConstraint final : public BodyConstraintSource {
   EnergyLimitSettings settings_;
   std::vector<double> u_max_;  // U_max,e [J], +inf = unlimited
   std::uint64_t key_prefix_;
+  int source_id_;
 };
 
 }  // namespace taut

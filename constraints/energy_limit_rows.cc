@@ -30,6 +30,13 @@ TetEnergyLimitRow CalcTetEnergyLimitRow(const TetRestElement& rest, const LamePa
   return row;
 }
 
+Mat12 CalcTetEnergyLimitCurvature(const TetRestElement& rest, const LameParameters& lame,
+                                  const std::array<Vec3, 4>& x, double u_max) {
+  // C = 1 - U/U_max, U = 1/2 (R^T x - X)^T K0 (R^T x - X) for frozen R: -d^2C = R K0 R^T/U_max.
+  const Mat3 R = CalcPolarRotation(CalcTetDeformationGradient(rest, x));
+  return CalcFrozenRotationTetStiffness(rest, lame, R) / u_max;
+}
+
 double CalcHexElementEnergy(const HexRestElement& rest, const HexNodes& x,
                             HexRotationMethod method) {
   return CalcCorotatedHexEnergy(rest, x, CalcHexRotation(rest, x, method));
@@ -47,6 +54,11 @@ HexEnergyLimitRow CalcHexEnergyLimitRow(const HexRestElement& rest, const HexNod
   CalcEnergyLimitJacobian(forces.data(), 8, u_max, J.data());
   for (int n = 0; n < 8; ++n) row.J.segment<3>(3 * n) = J[n];
   return row;
+}
+
+Mat24 CalcHexEnergyLimitCurvature(const HexRestElement& rest, const Mat3& R, double u_max) {
+  // -d^2C/dx^2 = -d(J)/dx = -d(f_e)/dx / U_max = R K_e R^T / U_max (frozen R).
+  return CalcFrozenRotationHexStiffness(rest, R) / u_max;
 }
 
 }  // namespace taut

@@ -32,6 +32,12 @@ double CalcTetElementEnergy(const TetRestElement& rest, const LameParameters& la
 TetEnergyLimitRow CalcTetEnergyLimitRow(const TetRestElement& rest, const LameParameters& lame,
                                         const std::array<Vec3, 4>& x, double u_max);
 
+// Curvature -d^2 C/dx^2 = K_e(R)/U_max = R K0 R^T / U_max of a tet's energy row with the rotation
+// R = polar(G(x)) frozen (12x12, node-major, PSD; U_max > 0): the lagged geometric stiffness of
+// the row (issue 11 item 3; SOLVER_ANCHORS R2, a per-element stiffness factor).
+Mat12 CalcTetEnergyLimitCurvature(const TetRestElement& rest, const LameParameters& lame,
+                                  const std::array<Vec3, 4>& x, double u_max);
+
 // Energy limit of one hex, linearised with the element rotation R frozen: C(x + dx) ~ C + J . dx.
 struct HexEnergyLimitRow {
   Vec24 J = Vec24::Zero();  // dC/dx = f_e / U_max, node-major (local hex order) xyz [1/m]
@@ -47,5 +53,9 @@ double CalcHexElementEnergy(const HexRestElement& rest, const HexNodes& x,
 // the exact gradient of C(x) = 1 - U(x, R)/U_max for fixed R (U_max > 0).
 HexEnergyLimitRow CalcHexEnergyLimitRow(const HexRestElement& rest, const HexNodes& x,
                                         const Mat3& R, double u_max);
+
+// Curvature -d^2 C/dx^2 = R K_e R^T / U_max of a hex's energy row with R frozen (24x24, PSD;
+// U_max > 0), the derivative of CalcHexEnergyLimitRow's J (MATH.md §4).
+Mat24 CalcHexEnergyLimitCurvature(const HexRestElement& rest, const Mat3& R, double u_max);
 
 }  // namespace taut

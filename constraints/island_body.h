@@ -34,6 +34,24 @@ class IslandBody {
   virtual void CalcPositions(double h, const VecX& v, VecX& x) const = 0;
   // The deformable body behind this island body, or null.
   virtual const DeformableBody* deformable() const { return nullptr; }
+
+  // J^T A_diag^-1 J of a row entry J on block i: the entry's part of the diagonal Delassus
+  // estimate w_c = sum_i J_i^T M_i^-1 J_i (lumped or rigid mass; 0 on blocks that do not move).
+  virtual double CalcBlockMobility(int i, const Vec3& J) const = 0;
+
+  // Primal path (constraints/primal_solver.h): the Newton matrix H = A + added blocks, factored
+  // once per Newton iteration. H <- A.
+  virtual void ResetNewtonMatrix() = 0;
+  // True when H has an entry for the 3x3 block (i, j) (always for i == j).
+  virtual bool IsInNewtonPattern(int i, int j) const = 0;
+  // H(i, j) += block (blocks that do not move freely are dropped). Requires IsInNewtonPattern.
+  virtual void AddNewtonBlock(int i, int j, const Mat3& block) = 0;
+  // Factors H; throws SimulationError when it is not positive definite.
+  virtual void FactorNewtonMatrix() = 0;
+  // rhs <- H^-1 rhs (zero on blocks that do not move freely).
+  virtual void SolveNewton(Eigen::Ref<VecX> rhs) const = 0;
+  // out = H v (zero on blocks that do not move freely).
+  virtual void ApplyNewtonMatrix(const VecX& v, VecX& out) const = 0;
 };
 
 // The bodies of an island with velocities and positions of one SQP iterate.

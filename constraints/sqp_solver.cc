@@ -2,6 +2,7 @@
 
 #include "constraints/active_set_polish.h"
 #include "constraints/deformable_island_body.h"
+#include "constraints/kkt_certificate.h"
 
 #include <algorithm>
 #include <chrono>
@@ -33,36 +34,12 @@ void SqpSolver::CalcPositions(double h, const std::vector<IslandBody*>& bodies,
   for (size_t b = 0; b < bodies.size(); ++b) bodies[b]->CalcPositions(h, v[b], x_[b]);
 }
 
-double SqpSolver::CollectRows(double h, const std::vector<IslandBody*>& bodies,
-                              const std::vector<ConstraintSource*>& sources,
-                              const SqpSettings& settings) {
-  rows_.clear();
-  CalcPositions(h, bodies, v_k_);
-  const IslandIterate iterate(h, bodies, v_k_, x_);
-  for (ConstraintSource* source : sources) source->AppendIslandRows(iterate, rows_);
-  // Limit rows have C in fractions of the limit, contact and joint rows in metres.
-  const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
-  double violation = 0.0;
-  for (const ConstraintRow& row : rows_) {
-    const bool distance = row.type != RowType::kStrainLimit && row.type != RowType::kEnergyLimit;
-    violation = std::max(violation, row.violation() * (distance ? distance_scale : 1.0));
-  }
-  body_rows_.resize(bodies.size());
-  for (auto& rows : body_rows_) rows.clear();
-  for (size_t c = 0; c < rows_.size(); ++c) {
-    body_rows_[rows_[c].body].push_back(static_cast<int>(c));
-    if (rows_[c].body2 >= 0 && rows_[c].body2 != rows_[c].body)
-      body_rows_[rows_[c].body2].push_back(static_cast<int>(c));
-  }
-  return violation;
-}
-
 void SqpSolver::BuildDelassus(const std::vector<IslandBody*>& bodies) {
-  const int m = static_cast<int>(rows_.size());
+  const int m = rows_.size();
   W_.setZero(m, m);
   Y_.resize(bodies.size());
   for (size_t b = 0; b < bodies.size(); ++b) {
-    const std::vector<int>& rows = body_rows_[b];
+    const std::vector<int>& rows = rows_.body_rows(static_cast<int>(b));
     if (rows.empty()) continue;
     const int body = static_cast<int>(b);
     // Y_b = A_b^-1 J_b^T: scatter the row's entries on body b into columns, one multi-column
@@ -106,17 +83,10 @@ double SqpSolver::CalcMerit(double h, const std::vector<IslandBody*>& bodies,
          rho * CalcViolationSum(h, bodies, sources, v) / h;
 }
 
-double SqpSolver::CalcRowVelocity(const ConstraintRow& row, const std::vector<VecX>& v) const {
-  double jv = 0.0;
-  row.ForEachEntry(
-      [&](int body, int block, const Vec3& J) { jv += J.dot(v[body].segment<3>(3 * block)); });
-  return jv;
-}
-
 void SqpSolver::BuildPgsRows() {
   // Unilateral rows, and friction pairs on the Coulomb disk of their contact's normal row.
   pgs_rows_.assign(rows_.size(), MakeUnilateralRow());
-  for (size_t c = 0; c < rows_.size(); ++c) {
+  for (int c = 0; c < rows_.size(); ++c) {
     const ConstraintRow& row = rows_[c];
     if (row.bilateral) pgs_rows_[c] = MakeBilateralRow(row.lo, row.hi);
     if (row.friction_of == 0) continue;
@@ -128,22 +98,6 @@ void SqpSolver::BuildPgsRows() {
     p.lo = -std::numeric_limits<double>::infinity();
     p.mu = row.mu;
   }
-}
-
-void SqpSolver::WarmStart(const std::vector<std::pair<std::uint64_t, double>>& from) {
-  lambda_.setZero(static_cast<int>(rows_.size()));
-  for (size_t c = 0; c < rows_.size(); ++c) {
-    const auto it = std::lower_bound(from.begin(), from.end(),
-                                     std::make_pair(rows_[c].key, -HUGE_VAL));
-    if (it != from.end() && it->first == rows_[c].key) lambda_[c] = it->second;
-  }
-}
-
-void SqpSolver::StoreMultipliers(std::vector<std::pair<std::uint64_t, double>>& to) const {
-  to.clear();
-  for (size_t c = 0; c < rows_.size(); ++c)
-    if (lambda_[c] != 0.0) to.emplace_back(rows_[c].key, lambda_[c]);
-  std::sort(to.begin(), to.end());
 }
 
 void SqpSolver::Solve(double h, const std::vector<DeformableBody*>& bodies,
@@ -162,6 +116,7 @@ void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
   const size_t nb = bodies.size();
   x_.resize(nb);
   v_k_.resize(nb);
+  const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
   v_qp_.resize(nb);
   v_trial_.resize(nb);
   dv_.resize(nb);
@@ -175,67 +130,42 @@ void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
   bool restoring = false;
   for (int k = 0;; ++k) {
     auto t_rows = std::chrono::steady_clock::now();
-    const double violation = CollectRows(h, bodies, sources, settings);
+    const double violation = rows_.Collect(h, bodies, sources, v_k_, distance_scale);
     stats.ms_rows += MsSince(t_rows);
     if (k == 0) stats.violation_before = violation;
     stats.violation_after = violation;
-    stats.rows_strain = static_cast<int>(std::count_if(
-        rows_.begin(), rows_.end(), [](const auto& r) { return r.type == RowType::kStrainLimit; }));
-    stats.rows_energy = static_cast<int>(std::count_if(
-        rows_.begin(), rows_.end(), [](const auto& r) { return r.type == RowType::kEnergyLimit; }));
-    stats.rows_contact = static_cast<int>(std::count_if(
-        rows_.begin(), rows_.end(), [](const auto& r) { return r.type == RowType::kContact; }));
-    stats.rows_rigid_contact = static_cast<int>(
-        std::count_if(rows_.begin(), rows_.end(),
-                      [](const auto& r) { return r.type == RowType::kRigidContact; }));
-    stats.rows_joint = static_cast<int>(std::count_if(
-        rows_.begin(), rows_.end(), [](const auto& r) { return r.type == RowType::kJoint; }));
-    WarmStart(iterate_);
+    rows_.CountTypes(stats);
+    rows_.WarmStart(iterate_, lambda_);
     if (rows_.empty()) {
       lambda_.resize(0);
       break;  // nothing active: no LCP at all
     }
-    // Stationarity of the iterate: ||A(v_k - v*) - J_k^T lambda_k|| / ||J_k^T lambda_k||.
-    double residual = 0.0, force = 0.0;
-    for (size_t b = 0; b < nb; ++b) {
-      dv_[b] = v_k_[b] - bodies[b]->v_star();
-      bodies[b]->ApplySystemMatrix(dv_[b], scratch_);
-      VecX& jt = jt_;
-      jt.setZero(scratch_.size());
-      const int body = static_cast<int>(b);
-      for (int c : body_rows_[b])
-        rows_[c].ForEachEntry([&](int on, int block, const Vec3& J) {
-          if (on == body) jt.segment<3>(3 * block) += lambda_[c] * J;
-        });
-      // Constrained DOFs carry reaction forces: compare on free DOFs only (A v is 0 there).
-      for (int i = 0; i < bodies[b]->num_blocks(); ++i)
-        if (!bodies[b]->is_free_block(i)) jt.segment<3>(3 * i).setZero();
-      residual += (scratch_ - jt).squaredNorm();
-      force += jt.squaredNorm();
-    }
-    const double stationarity = force > 0.0 ? std::sqrt(residual / force) : std::sqrt(residual);
-    stats.stationarity = stationarity;
+    // Certificate of the iterate (constraints/kkt_certificate.h).
+    const KktResiduals kkt =
+        CalcKktResiduals(bodies, rows_, lambda_, v_k_, h, distance_scale, scratch_);
+    RecordKkt(kkt, stats);
+    const double stationarity = kkt.stationarity;
+    const bool force_free = lambda_.cwiseAbs().maxCoeff() == 0.0;
     // Converged: feasible to tolerance and stationary, or feasible with the line search stalled
     // (the QP direction no longer decreases the merit: more iterations would not move v), or
     // feasible again after restoration.
     const bool feasible = violation <= settings.violation_tolerance;
+    stats.converged =
+        IsCertified(kkt, settings.violation_tolerance, settings.stationarity_tolerance);
     if (feasible && (restoring || stationarity <= settings.stationarity_tolerance ||
-                     force == 0.0 || last_alpha < settings.stalled_step)) {
+                     force_free || last_alpha < settings.stalled_step)) {
       break;
     }
     if (k >= settings.max_iterations) {
       // SQP cap reached while infeasible: push-only restoration steps (MATH.md §5 "incremental
       // dlambda >= 0": feasible in a few iterations, at the price of stationarity).
-      if (feasible || k >= settings.max_iterations + settings.max_restoration_iterations) {
-        stats.converged = feasible;
-        break;
-      }
+      if (feasible || k >= settings.max_iterations + settings.max_restoration_iterations) break;
       restoring = true;
     }
     const auto t_solve = std::chrono::steady_clock::now();
     BuildDelassus(bodies);
     // q = C(x_k)/h + J_k (v* - v_k).
-    const int m = static_cast<int>(rows_.size());
+    const int m = rows_.size();
     q_.resize(m);
     for (int c = 0; c < m; ++c) {
       const ConstraintRow& row = rows_[c];
@@ -246,7 +176,7 @@ void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
       });
       q_[c] = restoring ? row.C / h : row.C / h + jdv;
       // Friction rows: w_t = J_t v = J_t (v* + Y lambda), so q = J_t v* (restoration: 0).
-      if (row.friction_of > 0) q_[c] = restoring ? 0.0 : jdv + CalcRowVelocity(row, v_k_);
+      if (row.friction_of > 0) q_[c] = restoring ? 0.0 : jdv + rows_.CalcRowVelocity(c, v_k_);
     }
     BuildPgsRows();
     if (restoring) {
@@ -268,7 +198,7 @@ void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     // v_QP = v* + Y lambda_QP (restoration: v_k + Y dlambda).
     for (size_t b = 0; b < nb; ++b) {
       v_qp_[b] = restoring ? v_k_[b] : bodies[b]->v_star();
-      const std::vector<int>& rows = body_rows_[b];
+      const std::vector<int>& rows = rows_.body_rows(static_cast<int>(b));
       for (size_t i = 0; i < rows.size(); ++i) v_qp_[b] += Y_[b].col(i) * lambda_qp_[rows[i]];
     }
     if (restoring) {
@@ -282,7 +212,7 @@ void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
       }
       for (size_t b = 0; b < nb; ++b) v_k_[b] += alpha * (v_qp_[b] - v_k_[b]);
       lambda_ += alpha * lambda_qp_;
-      StoreMultipliers(iterate_);
+      rows_.Store(lambda_, iterate_);
       stats.restoration_iterations++;
       stats.sqp_iterations = k + 1;
       stats.ms_solve += MsSince(t_solve);
@@ -302,12 +232,13 @@ void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     for (size_t b = 0; b < nb; ++b) v_k_[b] += alpha * (v_qp_[b] - v_k_[b]);
     lambda_ += alpha * (lambda_qp_ - lambda_);
     last_alpha = alpha;
-    StoreMultipliers(iterate_);
+    rows_.Store(lambda_, iterate_);
     stats.sqp_iterations = k + 1;
     stats.ms_solve += MsSince(t_solve);
   }
   for (size_t b = 0; b < nb; ++b) bodies[b]->set_v(v_k_[b]);
-  StoreMultipliers(previous_);
+  rows_.Store(lambda_, previous_);
+  stats.islands_dual++;
 }
 
 }  // namespace taut

@@ -30,7 +30,21 @@ struct StepStats {
   // Natural-map residual ||lambda - Proj_K(lambda - w)||_inf of the last QP at exit (PGS, after
   // any projected-Newton polish; MATH.md §5) [units of lambda and w].
   double lcp_residual = 0.0;
-  bool converged = true;          // violation within tolerance at the end (false: caps reached)
+  bool converged = true;          // every KKT residual below within tolerance at the end
+
+  // Which island solver ran (constraints/island_solver.h): the papers' dual PGS path, the primal
+  // augmented-Lagrangian Newton path, or none (no rows). With several islands: the count of each.
+  int islands_dual = 0;
+  int islands_primal = 0;
+  int newton_iterations = 0;      // primal path: Newton iterations over all SQP iterations
+  int pcg_iterations = 0;         // primal path: PCG iterations (1 per Newton step when local)
+  // Convergence certificate at the end of the step (constraints/kkt_certificate.h), worst island:
+  double kkt_primal = 0.0;           // max(0, -C) of every row (distance rows scaled), C units
+  double kkt_complementarity = 0.0;  // |C| of pushing rows, slip of sticking contacts, C units
+  double kkt_dual = 0.0;             // distance of lambda from its set, relative to max |lambda|
+  // The first two by row type (RowType order: strain, energy, contact, rigid contact, joint).
+  double kkt_primal_by_type[5] = {0, 0, 0, 0, 0};
+  double kkt_complementarity_by_type[5] = {0, 0, 0, 0, 0};
 
   int islands = 0;                // islands solved by the SQP (with at least one row source)
   int rigid_bodies_coupled = 0;   // dynamic rigid bodies solved inside deformable islands

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "constraints/curvature_blocks.h"
+#include "constraints/strain_limit_curvature.h"
 #include "plugin/tet_rest_data.h"
 
 namespace taut {
@@ -18,7 +20,7 @@ const TetElementModel& AsTets(const DeformableBody& body) {
 
 StrainLimitConstraint::StrainLimitConstraint(const DeformableBody& body,
                                              const StrainLimitSettings& settings, int source_id)
-    : body_(body), tets_(AsTets(body)), settings_(settings) {
+    : body_(body), tets_(AsTets(body)), settings_(settings), source_id_(source_id) {
   settings_.Validate(tets_.num_elements(), "body '" + body.name() + "' strain limits");
   TAUT_DEMAND(source_id >= 0 && source_id < (1 << 16), "strain limits: source id ", source_id,
               " out of range");
@@ -28,8 +30,8 @@ StrainLimitConstraint::StrainLimitConstraint(const DeformableBody& body,
   // kappa_eff <= max_j kappa^j (|V'_ji| <= 1; ||K w|| <= max kappa), so no row of an element is
   // active (C < tau) while every stretch lies in [1 - (1-tau)/max kappa_min,
   // 1 + (1-tau)/max kappa_max].
-  screen_ = settings_.projection == StrainProjection::kHyperbolic ||
-            settings_.projection == StrainProjection::kEllipsoid;
+  screen_ = params_.projection == StrainProjection::kHyperbolic ||
+            params_.projection == StrainProjection::kEllipsoid;
   const double slack = 1.0 - params_.activation_margin;
   stretch_hi_ = params_.has_max ? 1.0 + slack / params_.kappa_max.maxCoeff() : HUGE_VAL;
   stretch_lo_ = params_.has_min ? 1.0 - slack / params_.kappa_min.maxCoeff() : 0.0;
@@ -45,7 +47,8 @@ bool StrainLimitConstraint::IsSurelyInactive(const std::array<Vec3, 4>& xe, int 
   const Mat3 c = F.transpose() * F;
   double lo = HUGE_VAL, hi = -HUGE_VAL;
   for (int k = 0; k < 3; ++k) {
-    const double radius = std::abs(c(k, 0)) + std::abs(c(k, 1)) + std::abs(c(k, 2)) - std::abs(c(k, k));
+    const double radius =
+        std::abs(c(k, 0)) + std::abs(c(k, 1)) + std::abs(c(k, 2)) - std::abs(c(k, k));
     lo = std::min(lo, c(k, k) - radius);
     hi = std::max(hi, c(k, k) + radius);
   }
@@ -79,6 +82,27 @@ int StrainLimitConstraint::AppendRows(const VecX& x, int body_index,
   return static_cast<int>(rows.size()) - before;
 }
 
+void StrainLimitConstraint::AddIslandCurvature(const IslandIterate& iterate,
+                                               const ConstraintRow* rows, const double* weights,
+                                               int count, CurvatureSink& sink) const {
+  int element = -1;  // rows of one element are adjacent: one SVD per element
+  SignedSvd svd;
+  for (int c = 0; c < count; ++c) {
+    const ConstraintRow& row = rows[c];
+    if (RowKeySource(row.key) != source_id_ || !(weights[c] > 0.0)) continue;
+    const StrainLimitKey key = StrainLimitKey::Unpack(RowKeyPayload(row.key));
+    const TetRestRows& r = tets_.rest().elements[key.element].r;
+    if (key.element != element) {
+      element = key.element;
+      svd = CalcSignedSvd(
+          CalcTetDeformationGradient(r, tets_.GatherElement(iterate.x(row.body), element)));
+    }
+    const Mat12 H = CalcStrainLimitRowCurvature(r, svd, SelectStrainLimitFrame(settings_, element),
+                                                params_, key);
+    AddElementCurvatureBlocks<4>(H, weights[c], row.body, tets_.element_nodes(element), sink);
+  }
+}
+
 double StrainLimitConstraint::CalcElementViolation(const VecX& x, int e) const {
   const auto xe = tets_.GatherElement(x, e);
   if (IsSurelyInactive(xe, e)) return 0.0;
@@ -103,8 +127,8 @@ double StrainLimitConstraint::CalcMaxAxisStrain(const VecX& x, int axis) const {
   double strain = -1.0;
   for (int e = 0; e < tets_.num_elements(); ++e) {
     const Vec3 q = SelectStrainLimitFrame(settings_, e).col(axis);
-    strain = std::max(strain, CalcMaterialAxisStrain(tets_.rest().elements[e].r,
-                                                     tets_.GatherElement(x, e), q));
+    strain = std::max(
+        strain, CalcMaterialAxisStrain(tets_.rest().elements[e].r, tets_.GatherElement(x, e), q));
   }
   return strain;
 }

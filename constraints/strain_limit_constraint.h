@@ -22,8 +22,14 @@ class StrainLimitConstraint final : public BodyConstraintSource {
   int AppendRows(const VecX& x, int body_index, std::vector<ConstraintRow>& rows) override;
   double CalcMaxViolation(const VecX& x) const override;
   double CalcViolationSum(const VecX& x) const override;
+  // Adds weights[c] [-d^2 C_c/dx^2]_+ of the rows of this source (element and row decoded from
+  // the key) at the iterate: the s_i curvature of constraints/strain_limit_curvature.h.
+  void AddIslandCurvature(const IslandIterate& iterate, const ConstraintRow* rows,
+                          const double* weights, int count, CurvatureSink& sink) const override;
 
   const StrainLimitSettings& settings() const { return settings_; }
+  // The compiled limits (params().projection is the evaluated rule).
+  const StrainLimitParams& params() const { return params_; }
   // Strain |G q_j| - 1 along limit axis j of every element at x (for reports), largest value.
   double CalcMaxAxisStrain(const VecX& x, int axis) const;
 
@@ -40,6 +46,7 @@ class StrainLimitConstraint final : public BodyConstraintSource {
   StrainLimitSettings settings_;
   StrainLimitParams params_;
   std::uint64_t key_prefix_;
+  int source_id_;
   std::vector<StrainLimitRow> element_rows_;  // scratch, reused
   bool screen_ = false;                       // IsSurelyInactive applies
   double stretch_lo_ = 0.0, stretch_hi_ = HUGE_VAL;  // stretches that certainly emit no row

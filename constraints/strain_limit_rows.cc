@@ -63,35 +63,58 @@ class RowEvaluator {
     }
   }
 
-  // Hyperbolic (eqs. 11-12, 17-18) or orthogonal (eqs. 19-20) rows (j, i), j = 0..2.
+  // Hyperbolic (eqs. 11-12, 17-18) or orthogonal (eqs. 19-20) rows (j, i), j = 0..2. Hyperbolic
+  // rows are filtered: only those with C_j <= min_j C_j + band (SOLVER_ANCHORS R3); every C_j
+  // still counts for min C, so violations and the feasible set do not change.
   void EvaluatePerAxis(int i, StrainBound bound) {
+    const bool hyperbolic = params_.projection == StrainProjection::kHyperbolic;
+    std::array<double, 3> C;
+    double C_dominant = std::numeric_limits<double>::infinity();
+    for (int j = 0; j < 3; ++j) {
+      C[j] = CalcPerAxisValue(i, j, bound);
+      C_dominant = std::min(C_dominant, C[j]);
+    }
+    const double C_cut = hyperbolic ? C_dominant + params_.hyperbolic_row_band : C_dominant;
+    for (int j = 0; j < 3; ++j) {
+      if (std::isnan(C[j]) || !Accept(C[j])) continue;  // NaN: unlimited hyperbolic axis
+      if (hyperbolic && C[j] > C_cut) continue;         // implied by the dominant row
+      EmitPerAxis(i, j, bound, C[j]);
+    }
+  }
+
+  // C of row (j, i): hyperbolic 1 - kappa^j |V'_ji| |s_i - 1| (eqs. 11-12 times kappa^j), NaN
+  // for an unlimited axis (C == 1, no row); orthogonal |V'_ji| - |s_i - 1| / |d^j| (eqs. 19-20
+  // divided by |d^j|).
+  double CalcPerAxisValue(int i, int j, StrainBound bound) const {
+    const bool is_max = bound == StrainBound::kMax;
+    const double a = std::abs(V_prime_(j, i));
+    const double e = std::abs(svd_.s[i] - 1.0);
+    if (params_.projection == StrainProjection::kHyperbolic) {
+      const double kappa = is_max ? params_.kappa_max[j] : params_.kappa_min[j];
+      return kappa == 0.0 ? std::numeric_limits<double>::quiet_NaN() : 1.0 - kappa * a * e;
+    }
+    const double d = is_max ? params_.d_max_capped[j] : params_.d_min_capped[j];
+    return a - e / std::abs(d);
+  }
+
+  // Appends row (j, i) with its Jacobian.
+  void EmitPerAxis(int i, int j, StrainBound bound, double C) {
     const bool is_max = bound == StrainBound::kMax;
     const double sigma = is_max ? 1.0 : -1.0;  // sign(s_i - 1)
     const double e = svd_.s[i] - 1.0;
-    const bool hyperbolic = params_.projection == StrainProjection::kHyperbolic;
-    for (int j = 0; j < 3; ++j) {
-      const double w_j = V_prime_(j, i);
-      const double a = std::abs(w_j);
-      const std::int8_t axis = static_cast<std::int8_t>(j);
-      if (hyperbolic) {
-        const double kappa = is_max ? params_.kappa_max[j] : params_.kappa_min[j];
-        if (kappa == 0.0) continue;                      // unlimited axis: C == 1
-        const double C = 1.0 - kappa * a * std::abs(e);  // eqs. 11-12 times kappa^j
-        if (!Accept(C)) continue;
-        // dC = -kappa sigma [sgn(V'_ji)(s_i - 1) dV'_ji + |V'_ji| ds_i] (eqs. 17-18).
-        CalcGradients(i);
-        Emit(i, axis, bound, C,
-             -kappa * sigma * (Sign(w_j) * e * dw_.row(j).transpose() + a * ds_));
-      } else {
-        const double d = is_max ? params_.d_max_capped[j] : params_.d_min_capped[j];
-        const double kappa_hat = 1.0 / std::abs(d);
-        const double C = a - kappa_hat * std::abs(e);  // eqs. 19-20 divided by |d^j|
-        if (!Accept(C)) continue;
-        // dC = sgn(V'_ji) dV'_ji - sigma ds_i / |d^j|.
-        CalcGradients(i);
-        Emit(i, axis, bound, C, Sign(w_j) * dw_.row(j).transpose() - sigma * kappa_hat * ds_);
-      }
+    const double w_j = V_prime_(j, i);
+    const double a = std::abs(w_j);
+    const std::int8_t axis = static_cast<std::int8_t>(j);
+    CalcGradients(i);
+    if (params_.projection == StrainProjection::kHyperbolic) {
+      // dC = -kappa sigma [sgn(V'_ji)(s_i - 1) dV'_ji + |V'_ji| ds_i] (eqs. 17-18).
+      const double kappa = is_max ? params_.kappa_max[j] : params_.kappa_min[j];
+      Emit(i, axis, bound, C, -kappa * sigma * (Sign(w_j) * e * dw_.row(j).transpose() + a * ds_));
+      return;
     }
+    // dC = sgn(V'_ji) dV'_ji - sigma ds_i / |d^j|.
+    const double d = is_max ? params_.d_max_capped[j] : params_.d_min_capped[j];
+    Emit(i, axis, bound, C, Sign(w_j) * dw_.row(j).transpose() - sigma / std::abs(d) * ds_);
   }
 
   // Linear interpolation (eqs. 21-22): L = ||diag(s^j) w||, delta = |L - 1|,
@@ -198,6 +221,24 @@ bool StrainLimitKey::operator==(const StrainLimitKey& other) const {
 std::uint64_t StrainLimitKey::Pack() const {
   return ((static_cast<std::uint64_t>(element) * 3 + axis) * 3 + principal_axis) * 2 +
          static_cast<std::uint64_t>(bound);
+}
+
+StrainLimitKey StrainLimitKey::Unpack(std::uint64_t packed) {
+  StrainLimitKey key;
+  key.bound = static_cast<StrainBound>(packed % 2);
+  packed /= 2;
+  key.principal_axis = static_cast<std::int8_t>(packed % 3);
+  packed /= 3;
+  key.axis = static_cast<std::int8_t>(packed % 3);
+  key.element = static_cast<int>(packed / 3);
+  return key;
+}
+
+int FindMatchedPrincipalIndex(const std::array<int, 3>& match, int m) {
+  for (int i = 0; i < 3; ++i)
+    if (match[i] == m) return i;
+  TAUT_ASSERT(false);
+  return 0;
 }
 
 std::array<int, 3> CalcPrincipalAxisMatch(const Mat3& V_prime) {

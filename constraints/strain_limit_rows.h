@@ -42,6 +42,8 @@ struct StrainLimitKey {
   bool operator==(const StrainLimitKey& other) const;
   // One integer for hash maps: ((element * 3 + axis) * 3 + principal_axis) * 2 + bound.
   std::uint64_t Pack() const;
+  // Inverse of Pack (bits above the packed value, e.g. a source id, must be cleared).
+  static StrainLimitKey Unpack(std::uint64_t packed);
 };
 
 // One constraint row C(x) >= 0 of a tet, linearised: C(x + dx) ~ C + J . dx.
@@ -73,5 +75,8 @@ double CalcMaterialAxisStrain(const TetRestRows& r, const TetPositions& x, const
 // The permutation pi used by StrainLimitKey: result[i] = material axis matched to column i of
 // V' = Q^T V, maximising sum_i |V'_{pi(i) i}| (the first maximum of the six on ties).
 std::array<int, 3> CalcPrincipalAxisMatch(const Mat3& V_prime);
+
+// The principal index i whose direction is matched to material axis m (match[i] == m).
+int FindMatchedPrincipalIndex(const std::array<int, 3>& match, int m);
 
 }  // namespace taut

@@ -22,6 +22,31 @@ void DemandRotation(const Mat3& Q, const std::string& what, const std::string& w
 // 1/|s - 1| for a limited axis, 0 for an unlimited one (MATH.md §3 kappa form).
 double CalcKappa(double s, bool limited) { return limited ? 1.0 / std::abs(s - 1.0) : 0.0; }
 
+// True when the non-zero (limited) entries of kappa are all equal. Exact comparison: equal
+// limits given as equal doubles give bit-equal kappas.
+bool HasEqualLimitedEntries(const Vec3& kappa) {
+  double value = 0.0;
+  for (int j = 0; j < 3; ++j) {
+    if (kappa[j] == 0.0) continue;
+    if (value != 0.0 && kappa[j] != value) return false;
+    value = kappa[j];
+  }
+  return true;
+}
+
+// The rows evaluated for the settings: hyperbolic with equal limits on every limited axis of
+// both bounds becomes the ellipsoid rule (MATH.md §3: identical for one limited axis,
+// isotropy-consistent for more; SOLVER_ANCHORS R3).
+StrainProjection SelectEvaluatedProjection(const StrainLimitSettings& settings,
+                                           const StrainLimitParams& params) {
+  const bool equal =
+      HasEqualLimitedEntries(params.kappa_min) && HasEqualLimitedEntries(params.kappa_max);
+  if (settings.projection == StrainProjection::kHyperbolic && settings.equal_limits_use_ellipsoid &&
+      equal)
+    return StrainProjection::kEllipsoid;
+  return settings.projection;
+}
+
 }  // namespace
 
 StrainLimitSettings StrainLimitSettings::Isotropic(double s_min, double s_max,
@@ -81,6 +106,8 @@ void StrainLimitSettings::Validate(int num_elements, const std::string& where) c
               " is out of range; valid: [0, +inf]");
   TAUT_DEMAND(std::isfinite(svd_gap_epsilon) && svd_gap_epsilon >= 0.0, where,
               ": svd_gap_epsilon = ", svd_gap_epsilon, " is out of range; valid: finite and >= 0");
+  TAUT_DEMAND(hyperbolic_row_band >= 0.0, where, ": hyperbolic_row_band = ", hyperbolic_row_band,
+              " is out of range; valid: [0, +inf]");
 }
 
 StrainLimitParams CalcStrainLimitParams(const StrainLimitSettings& settings) {
@@ -99,6 +126,8 @@ StrainLimitParams CalcStrainLimitParams(const StrainLimitSettings& settings) {
   params.activation_margin = settings.activation_margin;
   params.svd_gap_epsilon = settings.svd_gap_epsilon;
   params.freeze_frame_jacobian = settings.freeze_frame_jacobian;
+  params.hyperbolic_row_band = settings.hyperbolic_row_band;
+  params.projection = SelectEvaluatedProjection(settings, params);
   return params;
 }
 

@@ -23,12 +23,16 @@ enum class StrainProjection {
   kOrthogonal,           // paper A eqs. 19-20: s^{j,i} = 1 + d^j |V'_ji|; freezes (MATH.md §6 A1).
   kLinearInterpolation,  // paper A eqs. 21-22: s^i = ||diag(s^j) w||; 6 rows; needs caps.
   kEllipsoid,            // MATH.md §3 2-norm variant: d^i = 1 / ||K w||; isotropy-consistent.
+                         // With equal limits on all axes this is paper A's isotropic limit
+                         // (eqs. 9-10): s_min <= s_i <= s_max for every i, in any frame.
 };
 
 // Value of s_max[j] meaning "no stretch limit on this axis" (s_min[j] = 0 means no compress limit).
 constexpr double kUnlimitedStretch = std::numeric_limits<double>::infinity();
 // Default activation margin tau: rows with C < tau are emitted (C = 1 at rest, 0 at the limit).
 constexpr double kDefaultStrainActivationMargin = 0.2;
+// Default band of the hyperbolic row filter (StrainLimitSettings::hyperbolic_row_band) [C units].
+constexpr double kDefaultHyperbolicRowBand = 0.05;
 
 // Strain limits of one body. Build with Isotropic() or PerAxis(), then Validate().
 struct StrainLimitSettings {
@@ -36,8 +40,21 @@ struct StrainLimitSettings {
   Vec3 s_min = Vec3::Zero();
   // Stretch limit per material axis j [-]: in (1, +inf), or kUnlimitedStretch. Default: unlimited.
   Vec3 s_max = Vec3::Constant(kUnlimitedStretch);
-  // Projection of axis limits onto principal directions. Default: paper A's hyperbolic rule.
+  // Projection of axis limits onto principal directions. Default: paper A's hyperbolic rule
+  // (Isotropic() defaults to kEllipsoid, paper A's isotropic limit).
   StrainProjection projection = StrainProjection::kHyperbolic;
+  // kHyperbolic only: when each bound's limits are equal on all of its limited axes, evaluate
+  // the ellipsoid rows instead (MATH.md §3, R3): one row per principal axis and bound,
+  // C = 1 - kappa |s_i - 1| ||P_L V' e_i|| (P_L: the limited axes). Identical to the hyperbolic
+  // rows for one limited axis; for two or three equal axes it is the isotropy-consistent limit
+  // (exactly d in every direction of the limited subspace) where the hyperbolic rule allows up
+  // to sqrt(2) d or sqrt(3) d (MATH.md §6 A3). false: paper A's rows. Default true.
+  bool equal_limits_use_ellipsoid = true;
+  // kHyperbolic only, >= 0 (may be +inf): per (principal axis i, bound) emit only the dominant
+  // row (smallest C over the axes j) and the rows with C_j < C_min + band. The others satisfy
+  // C_j >= C_min at the iterate, so the feasible set is unchanged (violations are always
+  // measured over every row); +inf emits every row (paper A). Default 0.05.
+  double hyperbolic_row_band = kDefaultHyperbolicRowBand;
   // Body limit frame Q: columns are the limit axes in rest coordinates; a rotation. Default I.
   Mat3 frame = Mat3::Identity();
   // Optional per-element frames (fibre directions), one rotation per tet; when non-empty they
@@ -57,9 +74,13 @@ struct StrainLimitSettings {
   // Use the frozen-frame Jacobian (dV/dx = 0), for comparison with the exact one. Default false.
   bool freeze_frame_jacobian = false;
 
-  // Equal limits s_min <= s <= s_max on all three axes (0 / kUnlimitedStretch = unlimited).
+  // Paper A's isotropic limit (eqs. 9-10): s_min <= s_i <= s_max for every principal stretch
+  // s_i, whatever the frame (0 / kUnlimitedStretch = unlimited). The default kEllipsoid rows
+  // are then exactly C = 1 - kappa |s_i - 1|, one per principal stretch and bound; other
+  // projections apply their own rule to the equal axis limits (kHyperbolic switches to the
+  // ellipsoid rows unless equal_limits_use_ellipsoid is false).
   static StrainLimitSettings Isotropic(double s_min, double s_max,
-                                       StrainProjection projection = StrainProjection::kHyperbolic);
+                                       StrainProjection projection = StrainProjection::kEllipsoid);
   // Per-axis limits (paper A §3.2: s^j_min, s^j_max on material axis j).
   static StrainLimitSettings PerAxis(const Vec3& s_min, const Vec3& s_max,
                                      StrainProjection projection = StrainProjection::kHyperbolic);
@@ -67,12 +88,14 @@ struct StrainLimitSettings {
   // Throws InputError naming `where`, the quantity, the axis or element and the valid range when a
   // limit is NaN or out of range, s_min > s_max, the projection is not a StrainProjection value, a
   // frame is not a rotation, the number of element frames differs from num_elements, or a cap /
-  // margin / epsilon is out of range.
+  // margin / epsilon / band is out of range.
   void Validate(int num_elements, const std::string& where) const;
 };
 
 // Compiled limits of one body, as used by the row evaluation (MATH.md §3).
 struct StrainLimitParams {
+  // The rows evaluated: settings.projection, or kEllipsoid for kHyperbolic with equal limits
+  // (StrainLimitSettings::equal_limits_use_ellipsoid).
   StrainProjection projection = StrainProjection::kHyperbolic;
   Vec3 kappa_min = Vec3::Zero();     // kappa^j = 1/(1 - s_min[j]); 0 = unlimited
   Vec3 kappa_max = Vec3::Zero();     // kappa^j = 1/(s_max[j] - 1); 0 = unlimited
@@ -83,9 +106,11 @@ struct StrainLimitParams {
   double activation_margin = kDefaultStrainActivationMargin;  // tau
   double svd_gap_epsilon = 1e-2;                              // R1 epsilon
   bool freeze_frame_jacobian = false;                         // dV/dx := 0
+  double hyperbolic_row_band = kDefaultHyperbolicRowBand;     // emit C_j <= C_min + band
 };
 
-// Converts validated settings into kappa and capped deviations (MATH.md §3).
+// Converts validated settings into kappa and capped deviations (MATH.md §3), and picks the
+// evaluated projection (equal hyperbolic limits -> ellipsoid).
 StrainLimitParams CalcStrainLimitParams(const StrainLimitSettings& settings);
 
 // The limit frame Q of element e: element_frames[e] when given, else the body frame.

@@ -8,7 +8,10 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 
+#include "demos/render/picture_recorder.h"
+#include "demos/scenes/demo_options.h"
 #include "demos/scenes/scene.h"
 
 namespace {
@@ -20,17 +23,26 @@ double Median(std::vector<double> values) {
   return values[values.size() / 2];
 }
 
+// The island solver path chosen by --solver (kAuto: the world's per-island rule).
+taut::IslandSolverKind& SolverChoice() {
+  static taut::IslandSolverKind kind = taut::IslandSolverKind::kAuto;
+  return kind;
+}
+
 // Runs the scene and writes its outputs; returns the process exit code.
 int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::string& out_dir,
-             bool vtk, int vtk_every) {
+             bool vtk, int vtk_every, bool png) {
   namespace fs = std::filesystem;
   fs::create_directories(out_dir);
   std::unique_ptr<taut::Scene> scene = info.make();
+  if (SolverChoice() != taut::IslandSolverKind::kAuto)
+    scene->world().mutable_solver_settings().solver = SolverChoice();
   std::ofstream csv(out_dir + "/steps.csv");
   csv.precision(17);
   csv << "step,time_s,ms_step,ms_unconstrained,ms_rows,ms_solve,ms_rigid,rows_strain,"
          "rows_energy,rows_contact,rows_rigid_contact,rows_joint,islands,rigid_bodies_coupled,pgs_sweeps,sqp_iterations,restoration_iterations,active_set_solves,"
-         "violation_before,violation_after,stationarity,converged";
+         "violation_before,violation_after,stationarity,converged,islands_dual,islands_primal,"
+         "newton_iterations,pcg_iterations,kkt_primal,kkt_complementarity,kkt_dual";
   for (const std::string& column : scene->CsvColumns()) csv << "," << column;
   csv << "\n";
   std::vector<double> ms_steps, values;
@@ -39,7 +51,11 @@ int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::strin
   double max_violation = 0.0;
   const auto run_start = std::chrono::steady_clock::now();
   auto last_progress = run_start;
-  if (vtk) scene->WriteVtkFrame(out_dir, 0);
+  if (vtk) scene->WriteVtkFrame(out_dir, 0, 0.0);
+  // Pictures (--png): snapshots are taken between the timed steps and rendered after the run.
+  std::unique_ptr<taut::render::PictureRecorder> pictures;
+  if (png) pictures = std::make_unique<taut::render::PictureRecorder>(out_dir, info.name, steps, dt);
+  if (pictures) pictures->Record(*scene, 0);
   for (int step = 1; step <= steps; ++step) {
     const auto t0 = std::chrono::steady_clock::now();
     scene->Step(dt);
@@ -57,12 +73,16 @@ int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::strin
         << "," << s.rows_contact << "," << s.rows_rigid_contact << "," << s.rows_joint << ","
         << s.islands << "," << s.rigid_bodies_coupled << "," << s.pgs_sweeps << "," << s.sqp_iterations << ","
         << s.restoration_iterations << "," << s.active_set_solves << "," << s.violation_before
-        << "," << s.violation_after << "," << s.stationarity << "," << (s.converged ? 1 : 0);
+        << "," << s.violation_after << "," << s.stationarity << "," << (s.converged ? 1 : 0) << ","
+        << s.islands_dual << "," << s.islands_primal << "," << s.newton_iterations << ","
+        << s.pcg_iterations << "," << s.kkt_primal << "," << s.kkt_complementarity << ","
+        << s.kkt_dual;
     values.clear();
     scene->AppendCsvValues(values);
     for (double v : values) csv << "," << v;
     csv << "\n";
-    if (vtk && step % vtk_every == 0) scene->WriteVtkFrame(out_dir, step / vtk_every);
+    if (vtk && step % vtk_every == 0) scene->WriteVtkFrame(out_dir, step / vtk_every, step * dt);
+    if (pictures) pictures->Record(*scene, step);
     if (std::chrono::duration<double>(t1 - last_progress).count() > 2.0 || step == steps) {
       std::fprintf(stderr, "\r%s: step %d/%d (%.0f%%), %.3f ms/step", info.name.c_str(), step,
                    steps, 100.0 * step / steps, Median(ms_steps));
@@ -93,8 +113,21 @@ int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::strin
   nlohmann::json figures;
   scene->WriteFigures(figures);
   summary["figures"] = figures;
+  if (pictures) {
+    const taut::render::PictureReport report = pictures->Finish(scene->GetCameraDirection());
+    nlohmann::json& entry = summary["pictures"];
+    entry["key_frames"] = report.key_frames;
+    entry["gif_frames"] = report.gif_frames;
+    entry["ms_capture_total"] = report.ms_capture;
+    entry["ms_render_key_frame"] = report.ms_render_frame;
+    entry["ms_render_gif_frame"] = report.ms_render_gif_frame;
+    entry["ms_write_png"] = report.ms_write_png;
+    entry["ms_write_gif_total"] = report.ms_write_gif;
+    for (const std::string& file : report.files)
+      entry["files"].push_back(std::filesystem::path(file).filename().string());
+  }
   std::ofstream(out_dir + "/summary.json") << summary.dump(2) << "\n";
-  std::cout << summary.dump(2) << "\n";
+  std::cout << taut::FormatRunReport(summary, out_dir) << std::flush;
   return 0;
 }
 
@@ -102,17 +135,31 @@ int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::strin
 
 int main(int argc, char** argv) {
   CLI::App app{"taut-demo: headless scenes of limited-elasticity deformable bodies in Bullet"};
-  bool list = false, vtk = false;
+  bool list = false, vtk = false, png = false;
   std::string scene_name, out_dir;
   int steps = 0, vtk_every = 1;
   double dt = 0.0;
   app.add_flag("--list", list, "List the scenes, one per line, and exit");
-  app.add_option("scene", scene_name, "Scene to run (see --list)");
-  app.add_option("--steps", steps, "Number of steps (default: the scene's)")->check(CLI::NonNegativeNumber);
-  app.add_option("--dt", dt, "Time step in seconds (default: the scene's)")->check(CLI::NonNegativeNumber);
-  app.add_option("--out", out_dir, "Output folder (default: out/<scene>)");
+  app.add_option("scene", scene_name, "Scene to run (see the list below or --list)");
+  // Positive values are checked by taut::ResolveDemoArguments (one-line errors).
+  CLI::Option* steps_option =
+      app.add_option("--steps", steps, "Number of steps, > 0 (default: the scene's)");
+  CLI::Option* dt_option =
+      app.add_option("--dt", dt, "Time step in seconds, > 0 (default: the scene's)");
+  app.add_option("--out", out_dir, "Output folder, created if missing (default: out/<scene>)");
+  app.footer("Scenes:\n" + taut::FormatSceneList());
   app.add_flag("--vtk", vtk, "Write VTK frames of every deformable body");
   app.add_option("--vtk-every", vtk_every, "Write a VTK frame every N steps")->check(CLI::PositiveNumber);
+  app.add_flag("--png", png,
+               "Write pictures: the scene's key frames (key_*.png), figure.png and run.gif");
+  const std::map<std::string, taut::IslandSolverKind> solvers = {
+      {"auto", taut::IslandSolverKind::kAuto},
+      {"dual", taut::IslandSolverKind::kDual},
+      {"primal", taut::IslandSolverKind::kPrimal}};
+  app.add_option("--solver", SolverChoice(),
+                 "Island solver: auto (per island by rows per DOF), dual (the papers' PGS) or "
+                 "primal (augmented-Lagrangian Newton)")
+      ->transform(CLI::CheckedTransformer(solvers, CLI::ignore_case));
   CLI11_PARSE(app, argc, argv);
   try {
     if (list) {
@@ -120,15 +167,19 @@ int main(int argc, char** argv) {
         std::cout << info.name << "  # " << info.description << "\n";
       return 0;
     }
-    if (scene_name.empty()) {
-      std::cerr << "taut-demo: name a scene (see --list)\n";
+    taut::DemoArguments args;
+    args.scene = scene_name;
+    if (steps_option->count() > 0) args.steps = steps;
+    if (dt_option->count() > 0) args.dt = dt;
+    args.out_dir = out_dir;
+    taut::DemoRun run;
+    try {
+      run = taut::ResolveDemoArguments(args);
+    } catch (const taut::InputError& e) {
+      std::cerr << "taut-demo: " << e.what() << "\n";
       return 2;
     }
-    const taut::SceneInfo& info = taut::FindScene(scene_name);
-    if (steps == 0) steps = info.default_steps;
-    if (dt == 0.0) dt = info.default_dt;
-    if (out_dir.empty()) out_dir = "out/" + info.name;
-    return RunScene(info, steps, dt, out_dir, vtk, vtk_every);
+    return RunScene(*run.scene, run.steps, run.dt, run.out_dir, vtk, vtk_every, png);
   } catch (const std::exception& e) {
     std::cerr << "taut-demo: " << e.what() << "\n";
     return 1;

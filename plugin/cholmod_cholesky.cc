@@ -1,5 +1,6 @@
 #include "plugin/cholmod_cholesky.h"
 
+#if TAUT_WITH_CHOLMOD
 #include <cholmod.h>
 #include <dlfcn.h>
 
@@ -7,6 +8,9 @@
 #include <cmath>
 
 namespace taut {
+
+bool IsCholmodAvailable() { return true; }
+
 namespace internal {
 
 // CHOLMOD's settings, factor and the solve workspace of one CholmodCholesky.
@@ -249,3 +253,41 @@ int CholmodCholesky::num_supernodes() const {
 }
 
 }  // namespace taut
+
+#else  // !TAUT_WITH_CHOLMOD: a stub that says how to get CHOLMOD.
+
+namespace taut {
+
+bool IsCholmodAvailable() { return false; }
+
+namespace internal {
+struct CholmodState {};
+void CholmodStateDeleter::operator()(CholmodState* state) const { delete state; }
+}  // namespace internal
+
+namespace {
+// Throws the InputError of every factor or solve call in a build without CHOLMOD.
+[[noreturn]] void ThrowNoCholmod(const char* what) {
+  throw InputError(internal::Concat(
+      "CholmodCholesky::", what,
+      ": this build of taut has no CHOLMOD (LinearSolverKind::kCholmod needs a build configured "
+      "with -DTAUT_WITH_CHOLMOD=ON, which makes it GPL-2+; kAuto and kSparseLdlt work without)"));
+}
+}  // namespace
+
+CholmodCholesky::CholmodCholesky() = default;
+CholmodCholesky::~CholmodCholesky() = default;
+CholmodCholesky::CholmodCholesky(CholmodCholesky&&) noexcept = default;
+CholmodCholesky& CholmodCholesky::operator=(CholmodCholesky&&) noexcept = default;
+void CholmodCholesky::Analyze(const SparseMatrix&) { ThrowNoCholmod("Analyze"); }
+bool CholmodCholesky::Factorize(const SparseMatrix&) { ThrowNoCholmod("Factorize"); }
+void CholmodCholesky::Solve(Eigen::Ref<VecX>) const { ThrowNoCholmod("Solve"); }
+void CholmodCholesky::SolveColumns(Eigen::Ref<MatX>) const { ThrowNoCholmod("SolveColumns"); }
+void CholmodCholesky::SolveBlock(double*, Eigen::Index, int) const { ThrowNoCholmod("Solve"); }
+void CholmodCholesky::DemandReadyToSolve(Eigen::Index) const { ThrowNoCholmod("Solve"); }
+double CholmodCholesky::stored_entries_in_L() const { return 0.0; }
+int CholmodCholesky::num_supernodes() const { return 0; }
+
+}  // namespace taut
+
+#endif  // TAUT_WITH_CHOLMOD

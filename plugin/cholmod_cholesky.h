@@ -9,6 +9,11 @@
 
 namespace taut {
 
+// True when this build of taut links CHOLMOD. CHOLMOD's supernodal module is GPL-2+, so it is
+// opt-in (CMake option TAUT_WITH_CHOLMOD, off by default); without it every CholmodCholesky member
+// that would factor or solve throws InputError saying so.
+bool IsCholmodAvailable();
+
 namespace internal {
 struct CholmodState;
 // Frees the CHOLMOD factor and workspace of a state (defined next to CholmodState).
@@ -60,8 +65,9 @@ class CholmodCholesky {
   CholmodCholesky& operator=(CholmodCholesky&&) noexcept;
 
   // Symbolic phase: ordering, supernodal elimination tree and pattern of L, solve workspace.
-  // Values are ignored. Throws InputError for a non-square, empty or uncompressed matrix and
-  // SimulationError when CHOLMOD fails (out of memory, L too large for int indices).
+  // Values are ignored. Throws InputError for a non-square, empty or uncompressed matrix or when
+  // the build has no CHOLMOD (IsCholmodAvailable() false), SimulationError when CHOLMOD fails (out
+  // of memory, L too large for int indices).
   void Analyze(const SparseMatrix& pattern);
 
   // Numeric phase on a matrix with the analysed pattern (same outer index and nonzero count; the

@@ -40,6 +40,9 @@ class DeformableBody {
   NodeKind node_kind(int i) const { return kinds_[i]; }
   Vec3 node_position(int i) const { return x_.segment<3>(3 * i); }
   const ImplicitSystem& system() const { return system_; }
+  // The step's system, for the primal constraint solver's Newton matrix (between BeginStep and
+  // EndStep).
+  ImplicitSystem& mutable_system() { return system_; }
 
   // Sets positions/velocities (3N); throws InputError on size mismatch or non-finite values.
   void set_x(const VecX& x);

@@ -59,13 +59,15 @@ void ImplicitSystem::Build(const ElementModel& model, const std::vector<NodeKind
   }
   // Backend by size (see the class comment); the other one is emptied to free its memory.
   use_cholmod_ = requested_solver_ == LinearSolverKind::kCholmod ||
-                 (requested_solver_ == LinearSolverKind::kAuto && n >= kCholmodMinFreeDofs);
+                 (requested_solver_ == LinearSolverKind::kAuto && IsCholmodAvailable() &&
+                  n >= kCholmodMinFreeDofs);
   ldlt_ = SparseLdlt();
   cholmod_ = CholmodCholesky();
   if (n > 0 && use_cholmod_) cholmod_.Analyze(A_);
   if (n > 0 && !use_cholmod_) ldlt_.Analyze(A_);
   rhs_free_.resize(n);
   product_free_.resize(n);
+  newton_analyzed_ = false;
 }
 
 void ImplicitSystem::Assemble(const ElementModel& model, const VecX& mass, double c_M, double c_K) {
@@ -116,6 +118,76 @@ void ImplicitSystem::Multiply(const VecX& v, VecX& out) const {
   const int n = num_free_dofs();
   for (int i = 0; i < n; ++i) rhs_free_[i] = v[free_to_dof_[i]];
   product_free_.noalias() = A_ * rhs_free_;
+  out.setZero(v.size());
+  for (int i = 0; i < n; ++i) out[free_to_dof_[i]] = product_free_[i];
+}
+
+void ImplicitSystem::ResetNewtonMatrix() {
+  if (!newton_analyzed_) {
+    H_ = A_;
+    newton_ldlt_ = SparseLdlt();
+    newton_cholmod_ = CholmodCholesky();
+    if (num_free_dofs() > 0 && use_cholmod_) newton_cholmod_.Analyze(H_);
+    if (num_free_dofs() > 0 && !use_cholmod_) newton_ldlt_.Analyze(H_);
+    newton_analyzed_ = true;
+  }
+  std::copy(A_.valuePtr(), A_.valuePtr() + A_.nonZeros(), H_.valuePtr());
+}
+
+int ImplicitSystem::FindBlockRow(int a, int col) const {
+  const int row = dof_to_free_[3 * a];
+  const int* begin = A_.innerIndexPtr() + A_.outerIndexPtr()[col];
+  const int* end = A_.innerIndexPtr() + A_.outerIndexPtr()[col + 1];
+  const int* it = std::lower_bound(begin, end, row);
+  return (it != end && *it == row) ? static_cast<int>(it - A_.innerIndexPtr()) : -1;
+}
+
+bool ImplicitSystem::IsInPattern(int a, int b) const {
+  if (dof_to_free_[3 * a] < 0 || dof_to_free_[3 * b] < 0) return true;
+  return FindBlockRow(a, dof_to_free_[3 * b]) >= 0;
+}
+
+void ImplicitSystem::AddNewtonBlock(int a, int b, const Mat3& block) {
+  if (dof_to_free_[3 * a] < 0 || dof_to_free_[3 * b] < 0) return;
+  double* values = H_.valuePtr();
+  // A node's three DOFs are free together and the pattern couples whole nodes, so the three
+  // columns of node b have the same rows: node a's rows start at the same offset in each.
+  const int col = dof_to_free_[3 * b];
+  const int offset = FindBlockRow(a, col) - A_.outerIndexPtr()[col];
+  TAUT_ASSERT(offset >= 0);
+  for (int c = 0; c < 3; ++c) {
+    const int start = A_.outerIndexPtr()[col + c] + offset;
+    for (int r = 0; r < 3; ++r) values[start + r] += block(r, c);
+  }
+}
+
+void ImplicitSystem::FactorNewtonMatrix(const std::string& body) {
+  if (num_free_dofs() == 0) return;
+  const bool ok = use_cholmod_ ? newton_cholmod_.Factorize(H_)
+                               : newton_ldlt_.Factorize(H_) &&
+                                     newton_ldlt_.num_negative_pivots() == 0;
+  if (!ok)
+    throw SimulationError(internal::Concat("body '", body,
+                                           "': Newton matrix A + sum rho J^T J is not positive "
+                                           "definite (stage: primal constraint solve)"));
+}
+
+void ImplicitSystem::SolveNewton(Eigen::Ref<VecX> rhs) const {
+  const int n = num_free_dofs();
+  for (int i = 0; i < n; ++i) rhs_free_[i] = rhs[free_to_dof_[i]];
+  rhs.setZero();
+  if (n == 0) return;
+  if (use_cholmod_)
+    newton_cholmod_.Solve(rhs_free_);
+  else
+    newton_ldlt_.Solve(rhs_free_);
+  for (int i = 0; i < n; ++i) rhs[free_to_dof_[i]] = rhs_free_[i];
+}
+
+void ImplicitSystem::MultiplyNewton(const VecX& v, VecX& out) const {
+  const int n = num_free_dofs();
+  for (int i = 0; i < n; ++i) rhs_free_[i] = v[free_to_dof_[i]];
+  product_free_.noalias() = H_ * rhs_free_;
   out.setZero(v.size());
   for (int i = 0; i < n; ++i) out[free_to_dof_[i]] = product_free_[i];
 }

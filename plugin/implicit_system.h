@@ -13,9 +13,10 @@ namespace taut {
 
 // Which sparse factorization an ImplicitSystem uses.
 enum class LinearSolverKind {
-  kAuto,        // SparseLdlt below ImplicitSystem::kCholmodMinFreeDofs free DOFs, else CHOLMOD
+  kAuto,        // SparseLdlt; with TAUT_WITH_CHOLMOD, CHOLMOD from kCholmodMinFreeDofs free DOFs
   kSparseLdlt,  // always the allocation-free scalar LDL^T (plugin/sparse_ldlt.h)
-  kCholmod,     // always CHOLMOD's supernodal LL^T (plugin/cholmod_cholesky.h)
+  kCholmod,     // always CHOLMOD's supernodal LL^T (plugin/cholmod_cholesky.h); InputError at
+                // Build in a build without CHOLMOD (IsCholmodAvailable() false, the default)
 };
 
 // Symbolic structure built once per body (and again only when nodes are fixed or released):
@@ -23,7 +24,9 @@ enum class LinearSolverKind {
 // and the factorization's analysis. Each step then writes values through the map (no
 // setFromTriplets, no allocation) and refactors numerically.
 //
-// Backend by size (kAuto): the scalar up-looking SparseLdlt never touches the heap after Build, but
+// Backend (kAuto): SparseLdlt for every body unless the build links CHOLMOD (CMake option
+// TAUT_WITH_CHOLMOD, off by default because CHOLMOD's Supernodal module is GPL-2+); then by size:
+// the scalar up-looking SparseLdlt never touches the heap after Build, but
 // its flops grow like n^2 on 3D meshes and run one scalar at a time; CHOLMOD's supernodal
 // factorization runs them as dense BLAS-3 blocks but allocates inside every Factor. Factor + solve,
 // CHOLMOD vs SparseLdlt (bench/factorization_bench.cc, serial OpenBLAS): break-even near 400 free
@@ -60,6 +63,23 @@ class ImplicitSystem {
   // True when the last Build chose CHOLMOD.
   bool uses_cholmod() const { return use_cholmod_; }
 
+  // Newton matrix of the primal constraint solver: H = A + blocks added by AddNewtonBlock, on A's
+  // pattern, with its own numeric factor (the symbolic analysis is made on first use after Build).
+  // H <- A (this step's values).
+  void ResetNewtonMatrix();
+  // True when the 3x3 block between nodes a and b lies in A's pattern (or touches a node that is
+  // not free, whose DOFs are not in the system).
+  bool IsInPattern(int a, int b) const;
+  // H(a, b) += block on the free DOFs of nodes a and b; a block touching a fixed or kinematic
+  // node is dropped. Requires IsInPattern(a, b).
+  void AddNewtonBlock(int a, int b, const Mat3& block);
+  // Numeric factorization of H; throws SimulationError naming `body` if H is not positive definite.
+  void FactorNewtonMatrix(const std::string& body);
+  // rhs (3N) <- H^-1 rhs on free DOFs; constrained DOFs set to 0.
+  void SolveNewton(Eigen::Ref<VecX> rhs) const;
+  // out (3N) = H v on free DOFs, 0 on constrained DOFs.
+  void MultiplyNewton(const VecX& v, VecX& out) const;
+
  private:
   std::vector<int> dof_to_free_;   // (3N) free index or -1
   std::vector<int> free_to_dof_;   // (num_free)
@@ -70,6 +90,13 @@ class ImplicitSystem {
   bool use_cholmod_ = false;
   SparseLdlt ldlt_;          // the factor when !use_cholmod_
   CholmodCholesky cholmod_;  // the factor when use_cholmod_
+  // Value index of the first of the three rows of node a in column (free DOF) col, or -1.
+  int FindBlockRow(int a, int col) const;
+  // Newton matrix (primal solver): A's pattern, own values and factor.
+  Eigen::SparseMatrix<double> H_;
+  bool newton_analyzed_ = false;
+  SparseLdlt newton_ldlt_;
+  CholmodCholesky newton_cholmod_;
   mutable VecX rhs_free_;
   mutable MatX columns_free_;
   mutable VecX product_free_;

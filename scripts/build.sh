@@ -18,9 +18,9 @@ taut_install_deps() {
   bash "${TAUT_ROOT}/scripts/install_deps.sh"
 }
 
-# Configures DIR with Ninja and the given cmake arguments, then builds it. DIR is reused; a DIR
-# configured with another generator is removed first, since cmake refuses to switch generators.
-taut_configure_build() {
+# Configures DIR with Ninja and the given cmake arguments. DIR is reused; a DIR configured with
+# another generator is removed first, since cmake refuses to switch generators.
+taut_configure() {
   local dir="$1"
   shift
   local cache="${dir}/CMakeCache.txt"
@@ -30,13 +30,35 @@ taut_configure_build() {
   fi
   taut_stage "Configuring ${dir} ($*)"
   cmake -G Ninja -S "${TAUT_ROOT}" -B "${dir}" "$@"
-  taut_stage "Building ${dir} (-j${TAUT_JOBS})"
-  cmake --build "${dir}" -j"${TAUT_JOBS}"
+}
+
+# Configures DIR with the given cmake arguments (taut_configure), then builds all of it.
+taut_configure_build() {
+  taut_configure "$@"
+  taut_stage "Building $1 (-j${TAUT_JOBS})"
+  cmake --build "$1" -j"${TAUT_JOBS}"
 }
 
 # Release build in build/release (tests, demos and benchmarks on).
 taut_build_release() {
   taut_configure_build build/release -DCMAKE_BUILD_TYPE=Release
+}
+
+# Only the demo binary (and the libraries it links) in build/release: no tests, no benchmarks.
+taut_build_release_demo() {
+  taut_configure build/release -DCMAKE_BUILD_TYPE=Release
+  taut_stage "Building taut-demo in build/release (-j${TAUT_JOBS})"
+  cmake --build build/release -j"${TAUT_JOBS}" --target taut-demo
+}
+
+# Release build with CHOLMOD (-DTAUT_WITH_CHOLMOD=ON, GPL-2+) in build/cholmod: only the test
+# binary, to run CHOLMOD's tests; every object but plugin/cholmod_cholesky.cc compiles as in
+# build/release, so ccache makes this build mostly links.
+taut_build_cholmod_tests() {
+  taut_configure build/cholmod -DCMAKE_BUILD_TYPE=Release -DTAUT_WITH_CHOLMOD=ON \
+    -DTAUT_BUILD_BENCH=OFF -DTAUT_BUILD_DEMOS=OFF
+  taut_stage "Building taut_tests in build/cholmod (-j${TAUT_JOBS})"
+  cmake --build build/cholmod -j"${TAUT_JOBS}" --target taut_tests
 }
 
 # Debug build (assertions on, -O1 so Eigen-heavy tests finish) with AddressSanitizer and UBSan

@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
-# Builds and runs every check: (1) Release build + ctest, (2) install into build/stage and build
-# and run tests/consumer against the installed package, (3) Debug ASan/UBSan build + ctest,
-# (4) a 20 s libFuzzer run of every mesh reader.
+# Builds and runs every check: (1) Release build + ctest, then a check that the default build
+# links no GPL library (scripts/check_licenses.sh), (2) install into build/stage and build and run
+# tests/consumer against the installed package, (3) Debug ASan/UBSan build + ctest, (4) a 20 s
+# libFuzzer run of every mesh reader, (5) the opt-in CHOLMOD build (-DTAUT_WITH_CHOLMOD=ON,
+# build/cholmod, test binary only) and its solver tests.
 #   scripts/run_tests.sh [--quick | --sanitize-only]
-#     --quick          stages 1-2 only (skip the sanitizer build and the fuzz smoke)
+#     --quick          stages 1-2 only (skip the sanitizer build, the fuzz smoke and CHOLMOD)
 #     --sanitize-only  stages 3-4 only
 # Ends with one line giving each stage's wall time; exits non-zero on any failure.
 set -euo pipefail
@@ -22,7 +24,7 @@ for arg in "$@"; do
       run_consumer=0
       ;;
     -h | --help)
-      sed -n '2,7p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
+      sed -n '2,9p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
       exit 0
       ;;
     *)
@@ -46,6 +48,19 @@ run_ctest() {
 stage_release() {
   taut_build_release
   run_ctest build/release
+}
+
+# Stage 1b: the default build links no GPL code (CHOLMOD is opt-in).
+stage_licenses() {
+  bash scripts/check_licenses.sh build/release
+}
+
+# Stage 5: the opt-in CHOLMOD build's solver tests (CHOLMOD itself, backend choice, FEM steps).
+stage_cholmod() {
+  taut_build_cholmod_tests
+  taut_stage "ctest --test-dir build/cholmod (CHOLMOD and solver tests)"
+  ctest --test-dir build/cholmod --output-on-failure --no-tests=error -j"${TAUT_JOBS}" \
+    -R 'Cholmod|LinearSolverChoice|SparseLdlt|ImplicitSystem|Determinism'
 }
 
 # Stage 2: install the Release build and build a standalone project against it.
@@ -120,7 +135,9 @@ timings+=("deps $((SECONDS - current_start))s")
 current=""
 
 if ((run_release)); then run_stage release; fi
+if ((run_release)); then run_stage licenses; fi
 if ((run_consumer)); then run_stage consumer; fi
 if ((run_asan)); then run_stage asan; fi
 if ((run_asan)); then run_stage fuzz; fi
+if ((run_asan && run_release)); then run_stage cholmod; fi
 taut_stage "All stages passed"

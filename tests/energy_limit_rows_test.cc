@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
+
 #include "plugin/material.h"
+#include "plugin/signed_svd.h"
 #include "tests/test_utils.h"
 
 namespace taut {
@@ -261,6 +264,76 @@ TEST(EnergyLimitRowsTest, HexUniaxialStretchEnergyAndLimitValue) {
   VecX dx = VecX::Zero(24);
   for (int n = 0; n < 8; ++n) dx[3 * n] = X[n].x();
   EXPECT_NEAR(row.J.dot(dx), -1.0 / e, 1e-9 / e);
+}
+
+// Smallest eigenvalue over the norm of a symmetric matrix.
+template <typename M>
+double MinEigenvalueRatio(const M& H) {
+  return Eigen::SelfAdjointEigenSolver<M>(H, Eigen::EigenvaluesOnly).eigenvalues()[0] / H.norm();
+}
+
+// Curvature -d^2C/dx^2 = R K0 R^T/U_max: the row's J is the warped force over U_max,
+// J = -R K0 (R^T x - X)/U_max at R = polar(G) (corotated_tet_element.h), and the curvature is
+// the central difference of that J with R frozen.
+TEST(EnergyLimitRowsTest, TetCurvatureMatchesFdOfFrozenRotationJacobian) {
+  std::mt19937 rng(11);
+  const LameParameters lame = TestLame();
+  double worst = 0.0, worst_value = 0.0;
+  for (int trial = 0; trial < 100; ++trial) {
+    const auto X = RandomRestTet(rng);
+    const TetRestElement rest = MakeRest(X);
+    const auto x = Deform(X, trial % 2 == 0 ? 0.05 : 0.3, trial % 3 == 0, rng);
+    const double u_max = 1e-4;
+    const Mat3 R = CalcPolarRotation(CalcTetDeformationGradient(rest, x));
+    const Mat12 K0 = CalcFrozenRotationTetStiffness(rest, lame, Mat3::Identity());
+    Eigen::Matrix<double, 12, 12> R_bd = Eigen::Matrix<double, 12, 12>::Zero();
+    for (int n = 0; n < 4; ++n) R_bd.block<3, 3>(3 * n, 3 * n) = R;
+    const auto frozen_jacobian = [&](const VecX& v) -> VecX {
+      return -R_bd * K0 * (R_bd.transpose() * v - Flatten(X)) / u_max;
+    };
+    // The frozen-rotation J is the row's J at x ...
+    const VecX J_row = CalcTetEnergyLimitRow(rest, lame, x, u_max).J;
+    worst_value = std::max(worst_value, RelativeError(frozen_jacobian(Flatten(x)), J_row));
+    // ... and the curvature is its derivative.
+    const Mat12 H = CalcTetEnergyLimitCurvature(rest, lame, x, u_max);
+    const MatX fd = CentralDifference(frozen_jacobian, Flatten(x), 1e-7);
+    ASSERT_GT(fd.norm(), 1.0);
+    const double error = RelativeError(H, -fd);
+    worst = std::max(worst, error);
+    EXPECT_LT(error, 1e-6) << "trial " << trial;
+    EXPECT_GE(MinEigenvalueRatio(H), -1e-12);
+  }
+  std::printf(
+      "tet energy-limit curvature vs FD of J (R frozen): worst relative error %.2e (J at x vs "
+      "row J: %.2e)\n",
+      worst, worst_value);
+  EXPECT_LT(worst_value, 1e-9);
+}
+
+// Hex: -d^2C/dx^2 = R K_e R^T/U_max against central differences of CalcHexEnergyLimitRow's J.
+TEST(EnergyLimitRowsTest, HexCurvatureMatchesFdOfFrozenRotationJacobian) {
+  std::mt19937 rng(12);
+  const LameParameters lame = TestLame();
+  double worst = 0.0;
+  for (int trial = 0; trial < 40; ++trial) {
+    const HexRestElement rest = CalcHexRestElement(RandomRestHex(rng), lame);
+    const HexNodes x = DeformHex(rest.X, trial % 2 == 0 ? 0.05 : 0.3, rng);
+    const Mat3 R = CalcHexRotation(rest, x, HexRotationMethod::kCenterPolar);
+    const double u_max = 1e-3;
+    const Mat24 H = CalcHexEnergyLimitCurvature(rest, R, u_max);
+    const MatX fd = CentralDifference(
+        [&](const VecX& v) {
+          return VecX(CalcHexEnergyLimitRow(rest, UnflattenHex(v), R, u_max).J);
+        },
+        FlattenHex(x), 1e-7);
+    ASSERT_GT(fd.norm(), 1.0);
+    const double error = RelativeError(H, -fd);
+    worst = std::max(worst, error);
+    EXPECT_LT(error, 1e-6) << "trial " << trial;
+    EXPECT_GE(MinEigenvalueRatio(H), -1e-12);
+  }
+  std::printf("hex energy-limit curvature vs FD of J (R frozen): worst relative error %.2e\n",
+              worst);
 }
 
 }  // namespace

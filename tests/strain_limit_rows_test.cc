@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -20,6 +21,14 @@ const double kPi = std::acos(-1.0);
 constexpr StrainProjection kAllModes[] = {
     StrainProjection::kHyperbolic, StrainProjection::kOrthogonal,
     StrainProjection::kLinearInterpolation, StrainProjection::kEllipsoid};
+
+// Paper A's rows as printed: no switch to the ellipsoid rows for equal limits and no hyperbolic
+// row filter (the tests of the paper's rules and Jacobians use every row).
+StrainLimitSettings Paper(StrainLimitSettings settings) {
+  settings.equal_limits_use_ellipsoid = false;
+  settings.hyperbolic_row_band = kInf;
+  return settings;
+}
 
 // Uniformly random rotation from a normalized Gaussian quaternion.
 Mat3 RandomRotation(std::mt19937* rng) {
@@ -125,7 +134,7 @@ StrainLimitParams RandomParams(std::mt19937* rng, StrainProjection mode, int tri
     s_min.setConstant(s_min[0] == 0.0 ? 0.9 : s_min[0]);
     s_max.setConstant(std::isinf(s_max[0]) ? 1.1 : s_max[0]);
   }
-  StrainLimitSettings settings = StrainLimitSettings::PerAxis(s_min, s_max, mode);
+  StrainLimitSettings settings = Paper(StrainLimitSettings::PerAxis(s_min, s_max, mode));
   settings.svd_gap_epsilon = 0.0;  // exact derivatives for the FD comparison
   settings.Validate(1, "test");
   return CalcStrainLimitParams(settings);
@@ -289,8 +298,8 @@ TEST(StrainLimitRowsTest, EllipsoidEqualsHyperbolicForSingleLimitedAxis) {
     s_min[j] = 0.9;
     s_max[j] = 1.1;
     const auto rows_of = [&](StrainProjection mode) {
-      return AllRows(r, x, Q,
-                     CalcStrainLimitParams(StrainLimitSettings::PerAxis(s_min, s_max, mode)));
+      return AllRows(
+          r, x, Q, CalcStrainLimitParams(Paper(StrainLimitSettings::PerAxis(s_min, s_max, mode))));
     };
     const std::vector<StrainLimitRow> hyper = rows_of(StrainProjection::kHyperbolic);
     const std::vector<StrainLimitRow> ellip = rows_of(StrainProjection::kEllipsoid);
@@ -305,10 +314,12 @@ TEST(StrainLimitRowsTest, EllipsoidEqualsHyperbolicForSingleLimitedAxis) {
   }
 }
 
-// Effective stretch limit along v_1 for isotropic limits 1 +- d: the s_1 at which min C = 0.
-double EffectiveLimit(StrainProjection mode, const Mat3& Q, const Mat3& V, double d) {
-  const StrainLimitParams params =
-      CalcStrainLimitParams(StrainLimitSettings::Isotropic(1.0 - d, 1.0 + d, mode));
+// Effective stretch limit along v_1 for isotropic limits 1 +- d: the s_1 at which min C = 0
+// (paper: the mode's own rule, no switch of equal hyperbolic limits to the ellipsoid rows).
+double EffectiveLimit(StrainProjection mode, const Mat3& Q, const Mat3& V, double d,
+                      bool paper = true) {
+  StrainLimitSettings settings = StrainLimitSettings::Isotropic(1.0 - d, 1.0 + d, mode);
+  const StrainLimitParams params = CalcStrainLimitParams(paper ? Paper(settings) : settings);
   double lo = 1.0, hi = 1.0 + 3.0 * d;
   for (int it = 0; it < 60; ++it) {
     const double s1 = 0.5 * (lo + hi);
@@ -342,6 +353,8 @@ TEST(StrainLimitRowsTest, IsotropicLimitsEllipsoidExactHyperbolicUpToSqrt3) {
   V.col(2) = diag.cross(V.col(1));
   EXPECT_NEAR(EffectiveLimit(StrainProjection::kHyperbolic, Q, V, d), std::sqrt(3.0) * d, 1e-9);
   EXPECT_NEAR(EffectiveLimit(StrainProjection::kEllipsoid, Q, V, d), d, 1e-9);
+  // By default equal hyperbolic limits are evaluated as the ellipsoid rows: exactly d.
+  EXPECT_NEAR(EffectiveLimit(StrainProjection::kHyperbolic, Q, V, d, /*paper=*/false), d, 1e-9);
 }
 
 // Beam load path of MATH.md §3: G = Rz(phi) diag(a(1 + 1e-3), a) Rz(phi)^T (+) (1 - eps).
@@ -356,7 +369,7 @@ Mat3 BeamG(double phi_deg, double eps) {
 // Beam limits: e1 transverse in [0.95, 1.05], e2 transverse and e3 vertical unlimited.
 StrainLimitParams BeamParams(StrainProjection mode, double cap) {
   StrainLimitSettings settings =
-      StrainLimitSettings::PerAxis(Vec3(0.95, 0.0, 0.0), Vec3(1.05, kInf, kInf), mode);
+      Paper(StrainLimitSettings::PerAxis(Vec3(0.95, 0.0, 0.0), Vec3(1.05, kInf, kInf), mode));
   settings.unlimited_s_max_cap = cap;
   settings.Validate(1, "beam");
   return CalcStrainLimitParams(settings);
@@ -474,7 +487,7 @@ TEST(StrainLimitRowsTest, EmitsOnlyActiveSideBelowMargin) {
   std::mt19937 rng(60);
   for (const StrainProjection mode : kAllModes) {
     StrainLimitParams params =
-        CalcStrainLimitParams(StrainLimitSettings::Isotropic(0.9, 1.1, mode));
+        CalcStrainLimitParams(Paper(StrainLimitSettings::Isotropic(0.9, 1.1, mode)));
     for (int trial = 0; trial < 50; ++trial) {
       std::array<Vec3, 4> X;
       const TetRestRows r = MakeRestRows(&rng, &X);
@@ -527,6 +540,148 @@ TEST(StrainLimitRowsTest, MaterialAxisStrainAndFrame) {
   // In frame Q the 8 % stretch is on the 5 % axis: C = 1 - 0.08/0.05; in the world frame less.
   EXPECT_NEAR(CalcStrainLimitViolation(tet.r, tet.x, Q, params), 0.6, 1e-9);
   EXPECT_LT(CalcStrainLimitViolation(tet.r, tet.x, Mat3::Identity(), params), 0.6);
+}
+
+// Principal stretches of F computed independently of the rows (Eigen's JacobiSVD), signed like
+// MATH.md §0: the smallest is negated when det F < 0 (an inverted tet).
+Vec3 IndependentPrincipalStretches(const Mat3& F) {
+  Eigen::JacobiSVD<Mat3> svd(F);
+  Vec3 s = svd.singularValues();
+  if (F.determinant() < 0.0) s[2] = -s[2];
+  return s;
+}
+
+// Paper A eqs. 9-10: Isotropic(s_min, s_max) holds iff s_min <= s_i <= s_max for every
+// principal stretch, whatever the deformation's or the limit's frame; one row per principal
+// stretch (and the bound it points to), C = 1 - kappa |s_i - 1|.
+TEST(StrainLimitRowsTest, IsotropicMeansEveryPrincipalStretchWithinTheLimits) {
+  std::mt19937 rng(70);
+  std::uniform_real_distribution<double> u(0.93, 1.07), coin(0.0, 1.0);
+  const double lo = 0.96, hi = 1.04;
+  int feasible = 0, infeasible = 0;
+  for (const StrainProjection requested :
+       {StrainProjection::kEllipsoid, StrainProjection::kHyperbolic}) {
+    StrainLimitSettings settings = StrainLimitSettings::Isotropic(lo, hi);
+    settings.projection = requested;  // hyperbolic with equal limits: the same rows
+    const StrainLimitParams params = CalcStrainLimitParams(settings);
+    EXPECT_EQ(params.projection, StrainProjection::kEllipsoid);
+    for (int trial = 0; trial < 2000; ++trial) {
+      Vec3 s(u(rng), u(rng), u(rng));
+      if (coin(rng) < 0.05) s[2] = -s[2];
+      std::array<Vec3, 4> X;
+      const TetRestRows r = MakeRestRows(&rng, &X);
+      const Mat3 F = RandomRotation(&rng) * s.asDiagonal() * RandomRotation(&rng).transpose();
+      const TetPositions x = PositionsFromG(F, X, Vec3(0.3, 0.1, -0.2));
+      const Mat3 Q = RandomRotation(&rng);
+      const Vec3 s_ref = IndependentPrincipalStretches(F);
+      const bool within = (s_ref.array() >= lo).all() && (s_ref.array() <= hi).all();
+      const std::vector<StrainLimitRow> rows = AllRows(r, x, Q, params);
+      ASSERT_EQ(rows.size(), 3u);  // one per principal stretch (none is exactly 1)
+      double min_C = kInf;
+      for (const StrainLimitRow& row : rows) {
+        const double s_i = s_ref[row.principal_index];
+        const double kappa =
+            row.key.bound == StrainBound::kMax ? 1.0 / (hi - 1.0) : 1.0 / (1.0 - lo);
+        EXPECT_NEAR(row.C, 1.0 - kappa * std::abs(s_i - 1.0), 1e-9);
+        min_C = std::min(min_C, row.C);
+      }
+      // Away from the boundary (|C| > 1e-9) the row set decides exactly like the reference.
+      if (std::abs(min_C) < 1e-9) continue;
+      EXPECT_EQ(min_C >= 0.0, within) << "s = " << s_ref.transpose();
+      EXPECT_EQ(CalcStrainLimitViolation(r, x, Q, params) == 0.0, within);
+      (within ? feasible : infeasible) += 1;
+    }
+  }
+  std::printf("[ isotropic ] %d feasible, %d infeasible states agree with JacobiSVD\n", feasible,
+              infeasible);
+  EXPECT_GT(feasible, 200);
+  EXPECT_GT(infeasible, 200);
+  // The reported case: s_1 = 1.069 along the limit frame's diagonal satisfies paper A's
+  // hyperbolic rows with equal limits (1.04 allows up to 1 + sqrt(3) 0.04 = 1.069) but not the
+  // isotropic limit.
+  const Vec3 diag = Vec3::Ones().normalized();
+  Mat3 V;
+  V.col(0) = diag;
+  V.col(1) = diag.unitOrthogonal();
+  V.col(2) = diag.cross(V.col(1));
+  const Tet tet = TetFromG(V * Vec3(1.069, 1.0, 1.0).asDiagonal() * V.transpose());
+  const StrainLimitSettings isotropic = StrainLimitSettings::Isotropic(lo, hi);
+  EXPECT_NEAR(
+      CalcStrainLimitViolation(tet.r, tet.x, Mat3::Identity(), CalcStrainLimitParams(isotropic)),
+      0.069 / 0.04 - 1.0, 1e-9);
+  EXPECT_EQ(CalcStrainLimitViolation(tet.r, tet.x, Mat3::Identity(),
+                                     CalcStrainLimitParams(Paper(StrainLimitSettings::Isotropic(
+                                         lo, hi, StrainProjection::kHyperbolic)))),
+            0.0);
+}
+
+// Genuinely anisotropic hyperbolic limits, per (i, bound) only the dominant row and those within
+// the band: every emitted row is one of the full set (same C and J), min C and the violation
+// are unchanged (the dropped rows have C_j > C_min), and the row count drops.
+TEST(StrainLimitRowsTest, HyperbolicBandKeepsTheFeasibleSetWithFewerRows) {
+  std::mt19937 rng(80);
+  std::uniform_real_distribution<double> u(0.85, 1.15);
+  int full_rows = 0, kept_rows = 0, full_active = 0, kept_active = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const Vec3 s_min(0.9, 0.85, 0.95), s_max(1.1, 1.12, 1.05);
+    StrainLimitSettings full = Paper(StrainLimitSettings::PerAxis(s_min, s_max));
+    StrainLimitSettings banded = StrainLimitSettings::PerAxis(s_min, s_max);
+    const StrainLimitParams p_full = CalcStrainLimitParams(full);
+    const StrainLimitParams p_band = CalcStrainLimitParams(banded);
+    ASSERT_EQ(p_band.projection, StrainProjection::kHyperbolic);
+    std::array<Vec3, 4> X;
+    const TetRestRows r = MakeRestRows(&rng, &X);
+    const Mat3 F = RandomRotation(&rng) * Vec3(u(rng), u(rng), u(rng)).asDiagonal() *
+                   RandomRotation(&rng).transpose();
+    const TetPositions x = PositionsFromG(F, X, Vec3::Zero());
+    const Mat3 Q = RandomRotation(&rng);
+    const std::vector<StrainLimitRow> all = AllRows(r, x, Q, p_full);
+    const std::vector<StrainLimitRow> kept = AllRows(r, x, Q, p_band);
+    double min_all = kInf, min_kept = kInf;
+    for (const StrainLimitRow& row : all) min_all = std::min(min_all, row.C);
+    for (const StrainLimitRow& row : kept) {
+      min_kept = std::min(min_kept, row.C);
+      bool found = false;
+      for (const StrainLimitRow& other : all) {
+        if (!(other.key == row.key)) continue;
+        found = true;
+        EXPECT_EQ(other.C, row.C);
+        EXPECT_EQ((other.J - row.J).norm(), 0.0);
+      }
+      EXPECT_TRUE(found);
+    }
+    EXPECT_EQ(min_kept, min_all);
+    EXPECT_EQ(min_kept >= 0.0, min_all >= 0.0);
+    EXPECT_EQ(CalcStrainLimitViolation(r, x, Q, p_band), CalcStrainLimitViolation(r, x, Q, p_full));
+    full_rows += static_cast<int>(all.size());
+    kept_rows += static_cast<int>(kept.size());
+    // With the default margin tau = 0.2 (the rows an SQP sees).
+    std::vector<StrainLimitRow> active_full, active_kept;
+    AppendStrainLimitRows(0, r, x, Q, p_full, &active_full);
+    AppendStrainLimitRows(0, r, x, Q, p_band, &active_kept);
+    full_active += static_cast<int>(active_full.size());
+    kept_active += static_cast<int>(active_kept.size());
+  }
+  std::printf(
+      "[ hyperbolic band 0.05 ] rows (tau = inf) %d -> %d, active rows (tau = 0.2) %d -> %d\n",
+      full_rows, kept_rows, full_active, kept_active);
+  EXPECT_LT(kept_rows, full_rows / 2);
+  EXPECT_LT(kept_active, full_active);
+}
+
+// Pack and Unpack are inverse (the curvature pass decodes the element from a row key).
+TEST(StrainLimitRowsTest, KeyUnpackInvertsPack) {
+  for (const int element : {0, 1, 7, 123456}) {
+    for (int axis = 0; axis < 3; ++axis) {
+      for (int m = 0; m < 3; ++m) {
+        for (const StrainBound bound : {StrainBound::kMin, StrainBound::kMax}) {
+          const StrainLimitKey key{element, static_cast<std::int8_t>(axis),
+                                   static_cast<std::int8_t>(m), bound};
+          EXPECT_TRUE(StrainLimitKey::Unpack(key.Pack()) == key);
+        }
+      }
+    }
+  }
 }
 
 }  // namespace

@@ -45,6 +45,45 @@ TEST(StrainLimitsTest, FactoriesAndDefaultsAreValid) {
   EXPECT_EQ(finger.s_max, Vec3(1.05, 1.25, 1.02));
   EXPECT_STREQ(GetStrainProjectionName(StrainProjection::kLinearInterpolation),
                "linear_interpolation");
+  // Isotropic() is paper A's isotropic limit (eqs. 9-10): the ellipsoid rows.
+  EXPECT_EQ(StrainLimitSettings::Isotropic(0.96, 1.04).projection, StrainProjection::kEllipsoid);
+  EXPECT_TRUE(StrainLimitSettings().equal_limits_use_ellipsoid);
+  EXPECT_EQ(StrainLimitSettings().hyperbolic_row_band, kDefaultHyperbolicRowBand);
+}
+
+// Hyperbolic limits equal on every limited axis (per bound) are evaluated as ellipsoid rows
+// (MATH.md §3: identical for one axis, isotropy-consistent for more); unequal limits, other
+// modes and equal_limits_use_ellipsoid = false keep the requested rule.
+TEST(StrainLimitsTest, EqualHyperbolicLimitsSelectTheEllipsoidRows) {
+  const auto evaluated = [](const StrainLimitSettings& s) {
+    return CalcStrainLimitParams(s).projection;
+  };
+  const StrainProjection kHyp = StrainProjection::kHyperbolic;
+  EXPECT_EQ(evaluated(StrainLimitSettings::Isotropic(0.96, 1.04, kHyp)),
+            StrainProjection::kEllipsoid);
+  // The anisotropic tet beam: y and z limited alike, x free.
+  EXPECT_EQ(
+      evaluated(StrainLimitSettings::PerAxis(Vec3(0.0, 0.96, 0.96), Vec3(kInf, 1.04, 1.04), kHyp)),
+      StrainProjection::kEllipsoid);
+  // The vertical beam: one limited axis.
+  EXPECT_EQ(
+      evaluated(StrainLimitSettings::PerAxis(Vec3(0.95, 0.0, 0.0), Vec3(1.05, kInf, kInf), kHyp)),
+      StrainProjection::kEllipsoid);
+  // Different bounds per side are fine as long as each side is equal over its limited axes.
+  EXPECT_EQ(evaluated(StrainLimitSettings::PerAxis(Vec3(0.9, 0.0, 0.9), Vec3(1.2, 1.2, 1.2), kHyp)),
+            StrainProjection::kEllipsoid);
+  EXPECT_EQ(evaluated(StrainLimitSettings::PerAxis(Vec3(0.9, 0.8, 0.9), Vec3::Constant(1.2), kHyp)),
+            kHyp);
+  EXPECT_EQ(evaluated(StrainLimitSettings::PerAxis(Vec3::Zero(), Vec3(1.1, 1.2, kInf), kHyp)),
+            kHyp);
+  StrainLimitSettings paper = StrainLimitSettings::Isotropic(0.96, 1.04, kHyp);
+  paper.equal_limits_use_ellipsoid = false;
+  EXPECT_EQ(evaluated(paper), kHyp);
+  EXPECT_EQ(evaluated(StrainLimitSettings::Isotropic(0.96, 1.04, StrainProjection::kOrthogonal)),
+            StrainProjection::kOrthogonal);
+  EXPECT_EQ(
+      evaluated(StrainLimitSettings::Isotropic(0.96, 1.04, StrainProjection::kLinearInterpolation)),
+      StrainProjection::kLinearInterpolation);
 }
 
 TEST(StrainLimitsTest, ValidateRejectsBadLimitsNamingAxisAndRange) {
@@ -104,6 +143,13 @@ TEST(StrainLimitsTest, ValidateRejectsBadFramesAndOptions) {
   EXPECT_EQ(ValidateMessage(s), "");
   s.svd_gap_epsilon = -1e-3;
   ExpectError(s, {"svd_gap_epsilon = -0.001", ">= 0"});
+  s = StrainLimitSettings::Isotropic(0.95, 1.05);
+  s.hyperbolic_row_band = -0.1;
+  ExpectError(s, {"hyperbolic_row_band = -0.1", "[0, +inf]"});
+  s.hyperbolic_row_band = kNaN;
+  ExpectError(s, {"hyperbolic_row_band = nan"});
+  s.hyperbolic_row_band = kInf;
+  EXPECT_EQ(ValidateMessage(s), "");
 }
 
 // MATH.md §3: kappa = 1/|s - 1|, 0 for unlimited; OP / LI deviations use the caps.

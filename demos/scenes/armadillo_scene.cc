@@ -98,4 +98,10 @@ void ArmadilloScene::WriteFigures(nlohmann::json& figures) const {
   figures["credit"] = "Stanford 3D Scanning Repository (via Debian libcgal-demo)";
 }
 
+std::vector<Scene::KeyFrame> ArmadilloScene::CollectKeyFrames(int step, int num_steps) {
+  const double flattening = *std::max_element(max_flattening_.begin(), max_flattening_.end());
+  return CollectPeakKeyFrames(step, num_steps, flattening, &key_flattening_, "impact",
+                              "impact (largest flattening)", "rest");
+}
+
 }  // namespace taut

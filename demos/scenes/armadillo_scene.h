@@ -25,6 +25,8 @@ class ArmadilloScene : public Scene {
 
   void Step(double dt) override;
   void WriteFigures(nlohmann::json& figures) const override;
+  // Pictures: start, impact (largest flattening) and rest (the end).
+  std::vector<KeyFrame> CollectKeyFrames(int step, int num_steps) override;
   double max_flattening(int b) const { return max_flattening_[b]; }
   double deepest(int b) const { return deepest_[b]; }
   double max_energy_ratio(int b) const { return max_ratio_[b]; }
@@ -32,6 +34,7 @@ class ArmadilloScene : public Scene {
  private:
   std::vector<EnergyLimitConstraint*> limits_;
   std::vector<double> rest_height_, max_flattening_, deepest_, max_ratio_;
+  double key_flattening_ = 0.0;
 };
 
 }  // namespace taut

@@ -94,4 +94,9 @@ void BoxOnSphereScene::WriteFigures(nlohmann::json& figures) const {
   figures["coupled_rigid_bodies"] = world().last_step_stats().rigid_bodies_coupled;
 }
 
+std::vector<Scene::KeyFrame> BoxOnSphereScene::CollectKeyFrames(int step, int num_steps) {
+  return CollectPeakKeyFrames(step, num_steps, CalcFlattening(), &key_flattening_,
+                              "largest_flattening", "largest flattening of the sphere");
+}
+
 }  // namespace taut

@@ -19,6 +19,8 @@ class BoxOnSphereScene : public Scene {
   std::vector<std::string> CsvColumns() const override;
   void AppendCsvValues(std::vector<double>& values) const override;
   void WriteFigures(nlohmann::json& figures) const override;
+  // Pictures: start, the largest flattening of the sphere and the end.
+  std::vector<KeyFrame> CollectKeyFrames(int step, int num_steps) override;
 
   const btRigidBody& box(int k) const { return *boxes_[k]; }
   // Height of box k's centre [m].
@@ -36,6 +38,7 @@ class BoxOnSphereScene : public Scene {
   EnergyLimitConstraint* limit_ = nullptr;
   double max_tilt_ = 0.0, max_penetration_ = 0.0, max_ratio_ = 0.0;
   int max_rigid_rows_ = 0;
+  double key_flattening_ = 0.0;
 };
 
 }  // namespace taut

@@ -143,4 +143,10 @@ void CollapsingSphereScene::WriteFigures(nlohmann::json& figures) const {
   figures["mean_ms_step"] = mean_ms_step();
 }
 
+std::vector<Scene::KeyFrame> CollapsingSphereScene::CollectKeyFrames(int step, int num_steps) {
+  const double flattening = *std::max_element(max_flattening_.begin(), max_flattening_.end());
+  return CollectPeakKeyFrames(step, num_steps, flattening, &key_flattening_, "impact",
+                              "impact (largest flattening)", "rest");
+}
+
 }  // namespace taut

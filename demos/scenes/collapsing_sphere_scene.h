@@ -36,6 +36,8 @@ class CollapsingSphereScene : public Scene {
   std::vector<std::string> CsvColumns() const override;
   void AppendCsvValues(std::vector<double>& values) const override;
   void WriteFigures(nlohmann::json& figures) const override;
+  // Pictures: start, impact (largest flattening) and rest (the end).
+  std::vector<KeyFrame> CollectKeyFrames(int step, int num_steps) override;
 
   int num_spheres() const { return static_cast<int>(meters_.size()); }
   double max_flattening(int s) const { return max_flattening_[s]; }
@@ -61,6 +63,7 @@ class CollapsingSphereScene : public Scene {
   std::vector<double> rest_extent_, max_flattening_, max_ratio_, min_volume_ratio_, deepest_;
   int steps_ = 0;
   double ms_sum_ = 0.0;
+  double key_flattening_ = 0.0;
 };
 
 }  // namespace taut

@@ -100,4 +100,10 @@ void FallingSphereScene::WriteFigures(nlohmann::json& figures) const {
   }
 }
 
+std::vector<Scene::KeyFrame> FallingSphereScene::CollectKeyFrames(int step, int num_steps) {
+  const double flattening = *std::max_element(max_flattening_.begin(), max_flattening_.end());
+  return CollectPeakKeyFrames(step, num_steps, flattening, &key_flattening_, "impact",
+                              "impact (largest flattening)", "rest");
+}
+
 }  // namespace taut

@@ -26,6 +26,8 @@ class FallingSphereScene : public Scene {
   std::vector<std::string> CsvColumns() const override;
   void AppendCsvValues(std::vector<double>& values) const override;
   void WriteFigures(nlohmann::json& figures) const override;
+  // Pictures: start, impact (largest flattening) and rest (the end).
+  std::vector<KeyFrame> CollectKeyFrames(int step, int num_steps) override;
 
   // Lowest and highest node z of sphere s [m].
   double CalcBottom(int s) const;
@@ -39,6 +41,7 @@ class FallingSphereScene : public Scene {
   std::vector<EnergyLimitConstraint*> limits_;
   std::vector<bool> landed_;
   std::vector<double> max_flattening_, bounce_, deepest_, max_ratio_;
+  double key_flattening_ = 0.0;
 };
 
 }  // namespace taut

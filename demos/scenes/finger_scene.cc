@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "bullet_bridge/eigen_bullet.h"
 
@@ -366,6 +367,17 @@ void FingerScene::WriteFigures(nlohmann::json& figures) const {
         figures["indentation_ratio_anisotropic_to_isotropic"]
                [GetFingerPressAxisName(presses_[p].axis)] =
                    results_[p].indentation / results_[q].indentation;
+}
+
+std::vector<Scene::KeyFrame> FingerScene::CollectKeyFrames(int step, int /*num_steps*/) {
+  // The bone stops (force reached, locked or travel cap) and holds: the press at its deepest.
+  if (step == 0 || current_ >= num_presses() || !stopped_ || key_press_ >= current_) return {};
+  key_press_ = current_;
+  const FingerPressResult& r = results_[current_];
+  char caption[160];
+  std::snprintf(caption, sizeof(caption), "%s: %.1f N, %.2f mm (%s)", r.name.c_str(), r.reaction,
+                1e3 * r.indentation, r.stop_reason.c_str());
+  return {{"press_" + r.name, caption}};
 }
 
 }  // namespace taut

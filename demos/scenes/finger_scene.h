@@ -105,6 +105,8 @@ class FingerScene : public Scene {
   std::vector<std::string> CsvColumns() const override;
   void AppendCsvValues(std::vector<double>& values) const override;
   void WriteFigures(nlohmann::json& figures) const override;
+  // Pictures: each press when the bone stops (its largest indentation).
+  std::vector<KeyFrame> CollectKeyFrames(int step, int num_steps) override;
 
   int num_presses() const { return static_cast<int>(presses_.size()); }
   // Index of the press running now (num_presses() once all are done).
@@ -165,6 +167,7 @@ class FingerScene : public Scene {
   std::vector<double> sample_travel_, sample_energy_;  // recent (travel, U) after contact
   mutable VecX scratch_;                               // elastic forces (3N)
   double sqp_sum_ = 0.0, sweep_sum_ = 0.0, ms_sum_ = 0.0;
+  int key_press_ = -1;  // last press shown in a key frame
 };
 
 }  // namespace taut

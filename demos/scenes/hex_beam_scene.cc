@@ -116,4 +116,9 @@ void HexBeamScene::WriteFigures(nlohmann::json& figures) const {
   }
 }
 
+std::vector<Scene::KeyFrame> HexBeamScene::CollectKeyFrames(int step, int num_steps) {
+  const double sag = *std::max_element(max_tip_.begin(), max_tip_.end());
+  return CollectPeakKeyFrames(step, num_steps, sag, &key_sag_, "largest_sag", "largest sag");
+}
+
 }  // namespace taut

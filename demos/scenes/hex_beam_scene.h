@@ -32,6 +32,9 @@ class HexBeamScene : public Scene {
   std::vector<std::string> CsvColumns() const override;
   void AppendCsvValues(std::vector<double>& values) const override;
   void WriteFigures(nlohmann::json& figures) const override;
+  // Pictures: start, the largest sag (first swing) and the end; seen from the tip side.
+  std::vector<KeyFrame> CollectKeyFrames(int step, int num_steps) override;
+  Vec3 GetCameraDirection() const override { return Vec3(1.0, -0.55, 0.35); }
   // Displacement of the tip centre (mean of the x = L nodes) of beam b [m].
   Vec3 CalcTipDisplacement(int b) const;
   // max_e U_e of beam b at its current state [J].
@@ -49,6 +52,7 @@ class HexBeamScene : public Scene {
   std::vector<double> max_ratio_;               // (num_beams) over the run
   std::vector<double> max_energy_;              // (num_beams) max_e U_e over the run [J]
   std::vector<double> max_tip_;                 // (num_beams) max |tip displacement| [m]
+  double key_sag_ = 0.0;                        // largest sag of the key frames so far [m]
 };
 
 }  // namespace taut

@@ -11,7 +11,8 @@ namespace taut {
 
 void Scene::Step(double dt) { world().stepSimulation(dt, 1, dt); }
 
-void Scene::WriteVtkFrame(const std::string& dir, int frame) const {
+void Scene::WriteVtkFrame(const std::string& dir, int frame, double time) const {
+  if (time < 0.0) time = frame;
   for (int b = 0; b < world().num_deformable_bodies(); ++b) {
     const DeformableBody& body = world().deformable_body(b);
     const auto* tets = dynamic_cast<const TetElementModel*>(&body.model());
@@ -26,6 +27,7 @@ void Scene::WriteVtkFrame(const std::string& dir, int frame) const {
     } else {
       WriteVtkHexLattice(dir + "/" + body.name() + name, hexes->lattice(), &positions);
     }
+    vtk_series_.Add(dir, body.name(), body.name() + name, time);
   }
   for (int i = 0; i < num_embedded_surfaces(); ++i) {
     const std::vector<Vec3> positions = CalcEmbeddedSurfacePositions(i);
@@ -34,7 +36,38 @@ void Scene::WriteVtkFrame(const std::string& dir, int frame) const {
     const std::string base = dir + "/" + world().deformable_body(embedded_[i].body).name() + name;
     WriteVtkSurface(base + ".vtk", positions, embedded_[i].surface.triangles);
     WriteEmbeddedSurfaceObj(base + ".obj", positions, embedded_[i].surface.triangles);
+    const std::string& body_name = world().deformable_body(embedded_[i].body).name();
+    vtk_series_.Add(dir, body_name + "_surface", body_name + name + ".vtk", time);
   }
+}
+
+std::vector<Scene::KeyFrame> Scene::CollectKeyFrames(int step, int num_steps) {
+  std::vector<KeyFrame> frames;
+  if (step == 0) frames.push_back({"start", "start"});
+  if (step == num_steps / 2 && step > 0 && step < num_steps)
+    frames.push_back({"middle", "step " + std::to_string(step)});
+  if (step == num_steps && step > 0) frames.push_back({"end", "end, step " + std::to_string(step)});
+  return frames;
+}
+
+std::vector<Scene::KeyFrame> CollectPeakKeyFrames(int step, int num_steps, double value,
+                                                  double* peak, const std::string& slot,
+                                                  const std::string& caption,
+                                                  const std::string& end_caption) {
+  std::vector<Scene::KeyFrame> frames;
+  if (step == 0) frames.push_back({"start", "start"});
+  // Grown by more than rounding: a quantity that stays flat keeps its first peak frame.
+  const bool grew = step > 0 && value > *peak * (1.0 + 1e-9) + 1e-12;
+  if (grew) *peak = value;
+  if (grew && step == num_steps) {
+    // Still growing at the end (e.g. a shortened run): one frame, replacing the earlier peak.
+    frames.push_back({slot, caption + ", end"});
+  } else if (grew) {
+    frames.push_back({slot, caption});  // replaces the frame of the previous peak
+  } else if (step == num_steps && step > 0) {
+    frames.push_back({"end", end_caption});
+  }
+  return frames;
 }
 
 namespace {

@@ -11,6 +11,7 @@
 #include "demos/scenes/bullet_world_holder.h"
 #include "plugin/embedded_surface.h"
 #include "plugin/surface_mesh.h"
+#include "plugin/vtk_collection_writer.h"
 
 namespace taut {
 
@@ -26,8 +27,21 @@ class Scene {
   virtual void AppendCsvValues(std::vector<double>& /*values*/) const {}
   // Scene figures for summary.json (e.g. tip_displacement_m per material).
   virtual void WriteFigures(nlohmann::json& figures) const = 0;
-  // Writes VTK files of every deformable body for frame `frame` into dir.
-  virtual void WriteVtkFrame(const std::string& dir, int frame) const;
+  // Writes VTK files of every deformable body for frame `frame` into dir, and adds each to the
+  // ParaView collection dir/<body>.pvd (dir/<body>_surface.pvd for an embedded surface) at `time`
+  // (the simulated time in seconds; negative: the frame number), so a run opens as one animation.
+  virtual void WriteVtkFrame(const std::string& dir, int frame, double time = -1.0) const;
+  // A picture of the run (--png): key frames with the same slot replace each other, so a scene
+  // can keep e.g. the frame of the largest sag so far.
+  struct KeyFrame {
+    std::string slot;     // file name part, e.g. "impact"
+    std::string caption;  // text drawn on the picture
+  };
+  // Key frames at the state after step `step` of num_steps (0: the initial state); called once per
+  // step, outside the timed Step. Default: first, middle and last step.
+  virtual std::vector<KeyFrame> CollectKeyFrames(int step, int num_steps);
+  // Direction from the scene towards the camera of the pictures (world frame, z up).
+  virtual Vec3 GetCameraDirection() const { return Vec3(0.45, -1.0, 0.5); }
 
   // Embeds `surface` in the lattice of hex body `body` (trilinear weights per vertex) so that
   // WriteVtkFrame also writes the deformed surface (VTK and OBJ) each frame. Returns its index.
@@ -35,6 +49,9 @@ class Scene {
   int num_embedded_surfaces() const { return static_cast<int>(embedded_.size()); }
   // Deformed vertex positions of embedded surface i at the bodies' current positions.
   std::vector<Vec3> CalcEmbeddedSurfacePositions(int i) const;
+  // Body index and embedding of surface i.
+  int embedded_surface_body(int i) const { return embedded_[i].body; }
+  const EmbeddedSurface& embedded_surface(int i) const { return embedded_[i].surface; }
 
   DeformableWorld& world() { return holder_.world; }
   const DeformableWorld& world() const { return holder_.world; }
@@ -49,7 +66,17 @@ class Scene {
     EmbeddedSurface surface;
   };
   std::vector<EmbeddedSurfaceOutput> embedded_;
+  // The .pvd collections WriteVtkFrame extends.
+  mutable VtkSeriesWriter vtk_series_;
 };
+
+// Key frames of a figure showing the extreme of a scene quantity: "start" at step 0, `slot` with
+// `caption` whenever `value` exceeds *peak (which it then raises) and "end" with `end_caption`
+// (only the peak frame, captioned "<caption>, end", when the value still grows at the last step).
+std::vector<Scene::KeyFrame> CollectPeakKeyFrames(int step, int num_steps, double value,
+                                                  double* peak, const std::string& slot,
+                                                  const std::string& caption,
+                                                  const std::string& end_caption = "end");
 
 // Settings of a scene body: name, E [Pa], nu = 0.3, density [kg/m^3], Rayleigh alpha [1/s].
 DeformableBodySettings MakeSceneBodySettings(const std::string& name, double youngs_modulus,

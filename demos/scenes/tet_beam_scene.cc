@@ -1,5 +1,7 @@
 #include "demos/scenes/tet_beam_scene.h"
 
+#include <algorithm>
+
 #include "plugin/box_tet_mesher.h"
 
 namespace taut {
@@ -89,6 +91,11 @@ void TetBeamScene::WriteFigures(nlohmann::json& figures) const {
     entry["strain_limited"] = b < static_cast<int>(limited_.size()) && limited_[b];
     entry["length_m"] = CalcLength(b);
   }
+}
+
+std::vector<Scene::KeyFrame> TetBeamScene::CollectKeyFrames(int step, int num_steps) {
+  const double sag = *std::max_element(max_tip_.begin(), max_tip_.end());
+  return CollectPeakKeyFrames(step, num_steps, sag, &key_sag_, "largest_sag", "largest sag");
 }
 
 }  // namespace taut

@@ -27,6 +27,9 @@ class TetBeamScene : public Scene {
   std::vector<std::string> CsvColumns() const override;
   void AppendCsvValues(std::vector<double>& values) const override;
   void WriteFigures(nlohmann::json& figures) const override;
+  // Pictures: start, the largest sag (first swing) and the end; seen from the tip side.
+  std::vector<KeyFrame> CollectKeyFrames(int step, int num_steps) override;
+  Vec3 GetCameraDirection() const override { return Vec3(1.0, -0.55, 0.35); }
   // Displacement of the tip centre (mean of the x = L nodes) of beam b [m].
   Vec3 CalcTipDisplacement(int b) const;
   // Current distance between the centres of the clamped face and the tip face of beam b [m].
@@ -36,6 +39,7 @@ class TetBeamScene : public Scene {
   std::vector<std::vector<int>> tip_nodes_;  // (num_beams) nodes at x = L
   std::vector<bool> limited_;                // (num_beams) has strain limits
   std::vector<double> max_tip_;              // largest |tip displacement| seen [m]
+  double key_sag_ = 0.0;                     // largest sag of the key frames so far [m]
 };
 
 }  // namespace taut

@@ -95,4 +95,19 @@ void VerticalBeamScene::WriteFigures(nlohmann::json& figures) const {
   figures["limit"] = "0.95 <= s <= 1.05 along x";
 }
 
+std::vector<Scene::KeyFrame> VerticalBeamScene::CollectKeyFrames(int step, int num_steps) {
+  std::vector<KeyFrame> frames;
+  if (step == 0) frames.push_back({"start", "start"});
+  // The columns are identical until a limit first binds, so their first violations coincide
+  // unless the modes differ before it: one frame per distinct step.
+  std::string modes;
+  for (size_t c = 0; c < modes_.size(); ++c)
+    if (step > 0 && first_violation_[c] == step)
+      modes += (modes.empty() ? "" : ", ") + std::string(GetStrainProjectionName(modes_[c]));
+  if (!modes.empty())
+    frames.push_back({"first_violation_step" + std::to_string(step), "first violation: " + modes});
+  if (step == num_steps && step > 0) frames.push_back({"end", "end"});
+  return frames;
+}
+
 }  // namespace taut

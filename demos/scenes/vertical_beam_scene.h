@@ -19,6 +19,8 @@ class VerticalBeamScene : public Scene {
   std::vector<std::string> CsvColumns() const override;
   void AppendCsvValues(std::vector<double>& values) const override;
   void WriteFigures(nlohmann::json& figures) const override;
+  // Pictures: start, the first limit violation of each mode (one frame when they coincide) and the end.
+  std::vector<KeyFrame> CollectKeyFrames(int step, int num_steps) override;
 
   // Largest strain |G e_x| - 1 over the elements of column c now.
   double CalcLimitedAxisStrain(int c) const;

@@ -1,0 +1,64 @@
+#include "constraints/island_rows.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace taut {
+
+double IslandRows::Collect(double h, const std::vector<IslandBody*>& bodies,
+                           const std::vector<ConstraintSource*>& sources,
+                           const std::vector<VecX>& v, double distance_scale) {
+  rows_.clear();
+  x_.resize(bodies.size());
+  for (size_t b = 0; b < bodies.size(); ++b) bodies[b]->CalcPositions(h, v[b], x_[b]);
+  const IslandIterate iterate(h, bodies, v, x_);
+  for (ConstraintSource* source : sources) source->AppendIslandRows(iterate, rows_);
+  double violation = 0.0;
+  for (const ConstraintRow& row : rows_)
+    violation = std::max(violation, row.violation() * (IsLimitRow(row) ? 1.0 : distance_scale));
+  body_rows_.resize(bodies.size());
+  for (auto& rows : body_rows_) rows.clear();
+  for (size_t c = 0; c < rows_.size(); ++c) {
+    body_rows_[rows_[c].body].push_back(static_cast<int>(c));
+    if (rows_[c].body2 >= 0 && rows_[c].body2 != rows_[c].body)
+      body_rows_[rows_[c].body2].push_back(static_cast<int>(c));
+  }
+  return violation;
+}
+
+void IslandRows::WarmStart(const KeyedMultipliers& from, VecX& lambda) const {
+  lambda.setZero(size());
+  for (size_t c = 0; c < rows_.size(); ++c) {
+    const auto it =
+        std::lower_bound(from.begin(), from.end(), std::make_pair(rows_[c].key, -HUGE_VAL));
+    if (it != from.end() && it->first == rows_[c].key) lambda[c] = it->second;
+  }
+}
+
+void IslandRows::Store(const VecX& lambda, KeyedMultipliers& to) const {
+  to.clear();
+  for (size_t c = 0; c < rows_.size(); ++c)
+    if (lambda[c] != 0.0) to.emplace_back(rows_[c].key, lambda[c]);
+  std::sort(to.begin(), to.end());
+}
+
+void IslandRows::CountTypes(StepStats& stats) const {
+  auto count = [this](RowType type) {
+    return static_cast<int>(
+        std::count_if(rows_.begin(), rows_.end(), [type](const auto& r) { return r.type == type; }));
+  };
+  stats.rows_strain = count(RowType::kStrainLimit);
+  stats.rows_energy = count(RowType::kEnergyLimit);
+  stats.rows_contact = count(RowType::kContact);
+  stats.rows_rigid_contact = count(RowType::kRigidContact);
+  stats.rows_joint = count(RowType::kJoint);
+}
+
+double IslandRows::CalcRowVelocity(int c, const std::vector<VecX>& v) const {
+  double jv = 0.0;
+  rows_[c].ForEachEntry(
+      [&](int body, int block, const Vec3& J) { jv += J.dot(v[body].segment<3>(3 * block)); });
+  return jv;
+}
+
+}  // namespace taut

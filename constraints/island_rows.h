@@ -1,0 +1,56 @@
+// The rows of one island at an SQP iterate, shared by both island solvers (dual PGS and primal
+// Newton): collection from the sources, the rows of each body, warm starts by row key.
+#pragma once
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "constraints/constraint_row.h"
+#include "constraints/island_body.h"
+#include "constraints/step_stats.h"
+
+namespace taut {
+
+// Multipliers by row key, sorted by key (warm starts across SQP iterations and steps).
+using KeyedMultipliers = std::vector<std::pair<std::uint64_t, double>>;
+
+// True for rows whose C is a fraction of a limit (strain, energy); the others are distances [m].
+inline bool IsLimitRow(const ConstraintRow& row) {
+  return row.type == RowType::kStrainLimit || row.type == RowType::kEnergyLimit;
+}
+
+class IslandRows {
+ public:
+  // Positions x_b of every body at velocities v, then the rows of every source there. Returns the
+  // largest row violation in units of the limit rows' C: distance rows are scaled by
+  // `distance_scale` (violation tolerance / contact tolerance).
+  double Collect(double h, const std::vector<IslandBody*>& bodies,
+                 const std::vector<ConstraintSource*>& sources, const std::vector<VecX>& v,
+                 double distance_scale);
+  // lambda (one per row) <- the multipliers of `from` with the same key, 0 for new rows.
+  void WarmStart(const KeyedMultipliers& from, VecX& lambda) const;
+  // to <- the nonzero multipliers of the rows by key, sorted.
+  void Store(const VecX& lambda, KeyedMultipliers& to) const;
+  // Row counts by type into stats (rows_strain, ...).
+  void CountTypes(StepStats& stats) const;
+  // J v of a row for per-body velocities v.
+  double CalcRowVelocity(int c, const std::vector<VecX>& v) const;
+
+  int size() const { return static_cast<int>(rows_.size()); }
+  bool empty() const { return rows_.empty(); }
+  const ConstraintRow& operator[](int c) const { return rows_[c]; }
+  const std::vector<ConstraintRow>& rows() const { return rows_; }
+  // Rows touching body b (either side).
+  const std::vector<int>& body_rows(int b) const { return body_rows_[b]; }
+  // Positions of body b at the collected iterate.
+  const VecX& x(int b) const { return x_[b]; }
+  const std::vector<VecX>& positions() const { return x_; }
+
+ private:
+  std::vector<ConstraintRow> rows_;
+  std::vector<std::vector<int>> body_rows_;
+  std::vector<VecX> x_;
+};
+
+}  // namespace taut

@@ -1,0 +1,39 @@
+// The constrained step of one island (DESIGN.md "One step", stage 6): the papers' dual path (PGS
+// per QP inside the SQP, constraints/sqp_solver.h) or the primal path (augmented-Lagrangian Newton,
+// constraints/primal_solver.h), chosen per island and step. Both share rows, keys and warm starts.
+#pragma once
+
+#include <vector>
+
+#include "constraints/primal_solver.h"
+#include "constraints/sqp_solver.h"
+
+namespace taut {
+
+class IslandSolver {
+ public:
+  // Rows per free DOF from which kAuto takes the primal path (measured, docs/solver.md "Choosing
+  // a path": the dual's cost grows like m n + m^2 per SQP iteration and W is rank-deficient once
+  // m approaches n; the primal's cost is one sparse factorization per Newton iteration).
+  static constexpr double kPrimalRowsPerDof = 0.3;
+
+  // Solves the island's step; the path taken is counted in stats.islands_dual / islands_primal.
+  void Solve(double h, const std::vector<IslandBody*>& bodies,
+             const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
+             StepStats& stats);
+  // Steps the primal path keeps an island after the dual path failed its certificate there.
+  static constexpr int kPrimalStepsAfterDualFailure = 20;
+
+  // The path kAuto takes for an island with `rows` rows (last step) on `free_dofs` free DOFs,
+  // `primal_steps_left` > 0 after a failed dual step.
+  static IslandSolverKind ChooseAuto(int rows, int free_dofs, int primal_steps_left = 0);
+
+ private:
+  SqpSolver dual_;
+  PrimalSolver primal_;
+  KeyedMultipliers warm_;  // last step's multipliers by key, whichever path ran
+  int last_rows_ = 0;      // rows at the end of the last step
+  int primal_steps_left_ = 0;  // > 0: the dual path failed recently, stay primal
+};
+
+}  // namespace taut

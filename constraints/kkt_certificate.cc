@@ -1,0 +1,88 @@
+#include "constraints/kkt_certificate.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace taut {
+
+double KktResiduals::max_primal() const { return *std::max_element(primal.begin(), primal.end()); }
+
+double KktResiduals::max_complementarity() const {
+  return *std::max_element(complementarity.begin(), complementarity.end());
+}
+
+bool IsCertified(const KktResiduals& kkt, double violation_tolerance,
+                 double stationarity_tolerance) {
+  return kkt.max_primal() <= violation_tolerance &&
+         kkt.max_complementarity() <= violation_tolerance && kkt.dual <= 1e-6 &&
+         kkt.stationarity <= stationarity_tolerance;
+}
+
+void RecordKkt(const KktResiduals& kkt, StepStats& stats) {
+  stats.stationarity = kkt.stationarity;
+  stats.kkt_primal = kkt.max_primal();
+  stats.kkt_complementarity = kkt.max_complementarity();
+  stats.kkt_dual = kkt.dual;
+  for (int i = 0; i < kNumRowTypes; ++i) {
+    stats.kkt_primal_by_type[i] = kkt.primal[i];
+    stats.kkt_complementarity_by_type[i] = kkt.complementarity[i];
+  }
+}
+
+double CalcStationarity(const std::vector<IslandBody*>& bodies, const IslandRows& rows,
+                        const VecX& lambda, const std::vector<VecX>& v, VecX& scratch) {
+  double residual = 0.0, force = 0.0;
+  VecX jt;
+  for (size_t b = 0; b < bodies.size(); ++b) {
+    bodies[b]->ApplySystemMatrix(v[b] - bodies[b]->v_star(), scratch);
+    jt.setZero(scratch.size());
+    const int body = static_cast<int>(b);
+    for (int c : rows.body_rows(body))
+      rows[c].ForEachEntry([&](int on, int block, const Vec3& J) {
+        if (on == body) jt.segment<3>(3 * block) += lambda[c] * J;
+      });
+    // Pinned blocks carry reaction forces: compare on free blocks only (A v is 0 there).
+    for (int i = 0; i < bodies[b]->num_blocks(); ++i)
+      if (!bodies[b]->is_free_block(i)) jt.segment<3>(3 * i).setZero();
+    residual += (scratch - jt).squaredNorm();
+    force += jt.squaredNorm();
+  }
+  return force > 0.0 ? std::sqrt(residual / force) : std::sqrt(residual);
+}
+
+KktResiduals CalcKktResiduals(const std::vector<IslandBody*>& bodies, const IslandRows& rows,
+                              const VecX& lambda, const std::vector<VecX>& v, double h,
+                              double distance_scale, VecX& scratch) {
+  KktResiduals kkt;
+  const double lambda_scale = lambda.size() > 0 ? lambda.cwiseAbs().maxCoeff() : 0.0;
+  const double active = 1e-9 * lambda_scale;  // lambda above this counts as pushing
+  double dual = 0.0;
+  for (int c = 0; c < rows.size(); ++c) {
+    const ConstraintRow& row = rows[c];
+    const int type = static_cast<int>(row.type);
+    const double scale = IsLimitRow(row) ? 1.0 : distance_scale;
+    kkt.primal[type] = std::max(kkt.primal[type], row.violation() * scale);
+    if (row.friction_of > 0) {
+      // Disk |lambda_t| <= mu lambda_n (checked once per pair, on its first row).
+      const int normal = c - row.friction_of;
+      const int first = normal + 1;
+      const double radius = row.mu * std::max(0.0, lambda[normal]);
+      const double norm_t = std::hypot(lambda[first], lambda[first + 1]);
+      if (row.friction_of == 1) dual = std::max(dual, norm_t - radius);
+      if (norm_t < radius * (1.0 - 1e-6) - active)
+        kkt.complementarity[type] = std::max(
+            kkt.complementarity[type], h * std::abs(rows.CalcRowVelocity(c, v)) * scale);
+    } else if (row.bilateral) {
+      dual = std::max({dual, row.lo - lambda[c], lambda[c] - row.hi});
+    } else {
+      dual = std::max(dual, -lambda[c]);
+      if (lambda[c] > active)
+        kkt.complementarity[type] = std::max(kkt.complementarity[type], std::abs(row.C) * scale);
+    }
+  }
+  kkt.dual = lambda_scale > 0.0 ? std::max(0.0, dual) / lambda_scale : 0.0;
+  kkt.stationarity = CalcStationarity(bodies, rows, lambda, v, scratch);
+  return kkt;
+}
+
+}  // namespace taut

@@ -1,0 +1,59 @@
+// Convergence certificate of a constrained step (both island solvers): the KKT residuals of
+//   min 1/2 ||v - v*||_A^2  s.t.  C(x0 + h v) >= 0 (bilateral: = 0), friction on the Coulomb disk,
+// at the solver's final iterate (v, lambda) with the rows linearized there (MATH.md §5).
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "constraints/island_rows.h"
+
+namespace taut {
+
+constexpr int kNumRowTypes = 5;  // RowType values
+
+// Residuals at an iterate. Distance rows (contacts, joints) count in limit-row units, i.e. times
+// violation_tolerance / contact_tolerance, so one tolerance applies to every row.
+struct KktResiduals {
+  // max(0, -C) (bilateral |C|) per row type.
+  std::array<double, kNumRowTypes> primal{};
+  // Unilateral rows with lambda > 0: |C| (the row must be at its bound); friction rows inside the
+  // disk: h |J_t v| (sticking contacts must not slide). Per row type.
+  std::array<double, kNumRowTypes> complementarity{};
+  // Distance of lambda from its set (lambda >= 0; [lo, hi]; |lambda_t| <= mu lambda_n) relative to
+  // max |lambda|.
+  double dual = 0.0;
+  // True when every residual is within tolerance: primal and complementarity <= violation_tolerance
+// (C units), dual <= 1e-6, stationarity <= stationarity_tolerance.
+bool IsCertified(const KktResiduals& kkt, double violation_tolerance,
+                 double stationarity_tolerance);
+
+// Writes the residuals into the step's statistics (kkt_*, stationarity).
+void RecordKkt(const KktResiduals& kkt, StepStats& stats);
+
+// ||A(v - v*) - J^T lambda|| / ||J^T lambda|| on free blocks (0 when there is no force).
+  double stationarity = 0.0;
+
+  double max_primal() const;
+  double max_complementarity() const;
+};
+
+// Residuals of `rows` (collected at v) with multipliers lambda. `scratch` is a work vector.
+KktResiduals CalcKktResiduals(const std::vector<IslandBody*>& bodies, const IslandRows& rows,
+                              const VecX& lambda, const std::vector<VecX>& v, double h,
+                              double distance_scale, VecX& scratch);
+
+// True when every residual is within tolerance: primal and complementarity <= violation_tolerance
+// (C units), dual <= 1e-6, stationarity <= stationarity_tolerance.
+bool IsCertified(const KktResiduals& kkt, double violation_tolerance,
+                 double stationarity_tolerance);
+
+// Writes the residuals into the step's statistics (kkt_*, stationarity).
+void RecordKkt(const KktResiduals& kkt, StepStats& stats);
+
+// ||A(v - v*) - J^T lambda|| / ||J^T lambda|| over the free blocks of every body (0 force:
+// the absolute residual).
+double CalcStationarity(const std::vector<IslandBody*>& bodies, const IslandRows& rows,
+                        const VecX& lambda, const std::vector<VecX>& v, VecX& scratch);
+
+}  // namespace taut

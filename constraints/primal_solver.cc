@@ -1,0 +1,485 @@
+#include "constraints/primal_solver.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <limits>
+
+namespace taut {
+
+namespace {
+double MsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+      .count();
+}
+
+double Dot(const std::vector<VecX>& a, const std::vector<VecX>& b) {
+  double sum = 0.0;
+  for (size_t i = 0; i < a.size(); ++i) sum += a[i].dot(b[i]);
+  return sum;
+}
+
+// Projection of y onto the disk |y| <= r and its Jacobian D = dProj/dy:
+// inside I; outside (r/|y|)(I - y y^T/|y|^2) (MATH.md §5, Coulomb disk).
+Eigen::Vector2d ProjectOnDisk(const Eigen::Vector2d& y, double r, Eigen::Matrix2d* D) {
+  const double norm = y.norm();
+  if (norm <= r) {
+    if (D) D->setIdentity();
+    return y;
+  }
+  if (norm == 0.0 || r <= 0.0) {
+    if (D) D->setZero();
+    return Eigen::Vector2d::Zero();
+  }
+  const Eigen::Vector2d unit = y / norm;
+  if (D) *D = (r / norm) * (Eigen::Matrix2d::Identity() - unit * unit.transpose());
+  return r * unit;
+}
+
+// Projection of a scalar multiplier onto its interval [lo, hi] (unilateral: [0, inf)).
+double ProjectOnInterval(double y, double lo, double hi, double* D) {
+  if (y <= lo) {
+    if (D) *D = 0.0;
+    return lo;
+  }
+  if (y >= hi) {
+    if (D) *D = 0.0;
+    return hi;
+  }
+  if (D) *D = 1.0;
+  return y;
+}
+
+double LowerBound(const ConstraintRow& row) { return row.bilateral ? row.lo : 0.0; }
+double UpperBound(const ConstraintRow& row) {
+  return row.bilateral ? row.hi : std::numeric_limits<double>::infinity();
+}
+
+// Collects curvature blocks of the sources into the solver's list.
+class CurvatureList final : public CurvatureSink {
+ public:
+  template <typename Add>
+  explicit CurvatureList(Add&& add) : add_(std::forward<Add>(add)) {}
+  void AddBlock(int body, int a, int b, const Mat3& block) override { add_(body, a, b, block); }
+
+ private:
+  std::function<void(int, int, int, const Mat3&)> add_;
+};
+}  // namespace
+
+void PrimalSolver::CalcPenalties(const std::vector<IslandBody*>& bodies,
+                                 const PrimalSettings& settings) {
+  const int m = rows_.size();
+  rho_.setZero(m);
+  for (int c = 0; c < m; ++c) {
+    const ConstraintRow& row = rows_[c];
+    if (row.friction_of > 0) {
+      rho_[c] = rho_[c - row.friction_of];
+      continue;
+    }
+    // w_c = sum_i J_ci^T M_i^-1 J_ci: the diagonal of W with A replaced by its mass part.
+    double w = 0.0;
+    row.ForEachEntry([&](int body, int block, const Vec3& J) {
+      w += bodies[body]->CalcBlockMobility(block, J);
+    });
+    rho_[c] = w > 0.0 ? settings.penalty_scale / w : 0.0;
+  }
+}
+
+void PrimalSolver::LinearizeRows(double h, const std::vector<IslandBody*>& bodies) {
+  const int m = rows_.size();
+  g0_.resize(m);
+  in_pattern_.assign(m, 1);
+  coupled_ = false;
+  for (int c = 0; c < m; ++c) {
+    const ConstraintRow& row = rows_[c];
+    // g_c(v_ + dv) = C_c/h + J_c dv = g0_c + J_c (v_ + dv); friction rows target J_t v = 0.
+    g0_[c] = row.friction_of > 0 ? 0.0 : row.C / h - rows_.CalcRowVelocity(c, v_);
+    row.ForEachEntry([&](int body_a, int a, const Vec3&) {
+      row.ForEachEntry([&](int body_b, int b, const Vec3&) {
+        if (body_a == body_b && !bodies[body_a]->IsInNewtonPattern(a, b)) in_pattern_[c] = 0;
+      });
+    });
+    const bool two_sided = row.body2 >= 0 && row.body2 != row.body;
+    if (two_sided || !in_pattern_[c]) coupled_ = true;
+  }
+  // A friction pair is held on the pattern only as a whole (its D couples the two rows).
+  for (int c = 0; c < m; ++c)
+    if (rows_[c].friction_of == 1) in_pattern_[c] = in_pattern_[c + 1] = in_pattern_[c] && in_pattern_[c + 1];
+}
+
+void PrimalSolver::CollectCurvature(double h, const std::vector<IslandBody*>& bodies,
+                                    const std::vector<ConstraintSource*>& sources) {
+  curvature_.clear();
+  VecX weights = VecX::Zero(rows_.size());
+  bool any = false;
+  for (int c = 0; c < rows_.size(); ++c) {
+    if (!IsLimitRow(rows_[c]) || lambda_[c] <= 0.0) continue;
+    weights[c] = h * lambda_[c];  // d^2 Phi/dv^2 of -lambda g: h lambda [-d^2 C/dx^2]
+    any = true;
+  }
+  if (!any) return;
+  CurvatureList sink([this](int body, int a, int b, const Mat3& block) {
+    curvature_.push_back({body, a, b, block});
+  });
+  const IslandIterate iterate(h, bodies, v_, rows_.positions());
+  for (const ConstraintSource* source : sources)
+    source->AddIslandCurvature(iterate, rows_.rows().data(), weights.data(), rows_.size(), sink);
+}
+
+void PrimalSolver::CalcProjectedMultipliers() {
+  const int m = rows_.size();
+  lambda_.resize(m);
+  d_unit_.resize(m);
+  d_disk_.resize(m);
+  for (int c = 0; c < m; ++c) jv_[c] = rows_.CalcRowVelocity(c, v_);
+  for (int c = 0; c < m; ++c) {
+    const ConstraintRow& row = rows_[c];
+    if (row.friction_of == 2) continue;  // done with its pair
+    if (row.friction_of == 1) {
+      // y_t = lambda_bar_t - rho J_t v on the disk of radius mu lambda_bar_n.
+      const double radius = row.mu * std::max(0.0, lambda_bar_[c - 1]);
+      const Eigen::Vector2d y(lambda_bar_[c] - rho_[c] * jv_[c],
+                              lambda_bar_[c + 1] - rho_[c] * jv_[c + 1]);
+      const Eigen::Vector2d t = ProjectOnDisk(y, radius, &d_disk_[c]);
+      lambda_[c] = t[0];
+      lambda_[c + 1] = t[1];
+      continue;
+    }
+    const double y = lambda_bar_[c] - rho_[c] * (g0_[c] + jv_[c]);
+    lambda_[c] = ProjectOnInterval(y, LowerBound(row), UpperBound(row), &d_unit_[c]);
+  }
+}
+
+void PrimalSolver::AddCurvatureTimes(const std::vector<VecX>& u, std::vector<VecX>& out) const {
+  for (const CurvatureBlock& g : curvature_)
+    out[g.body].segment<3>(3 * g.a) += g.block * u[g.body].segment<3>(3 * g.b);
+}
+
+void PrimalSolver::CalcGradient(const std::vector<IslandBody*>& bodies) {
+  const size_t nb = bodies.size();
+  for (size_t b = 0; b < nb; ++b)
+    bodies[b]->ApplySystemMatrix(v_[b] - bodies[b]->v_star(), grad_[b]);
+  for (int c = 0; c < rows_.size(); ++c) {
+    if (lambda_[c] == 0.0) continue;
+    rows_[c].ForEachEntry([&](int body, int block, const Vec3& J) {
+      grad_[body].segment<3>(3 * block) -= lambda_[c] * J;
+    });
+  }
+  for (size_t b = 0; b < nb; ++b)
+    for (int i = 0; i < bodies[b]->num_blocks(); ++i)
+      if (!bodies[b]->is_free_block(i)) grad_[b].segment<3>(3 * i).setZero();
+}
+
+void PrimalSolver::AddRowProduct(const std::vector<IslandBody*>& bodies, int p, int q,
+                                 double scale) {
+  rows_[p].ForEachEntry([&](int body_a, int a, const Vec3& Ja) {
+    rows_[q].ForEachEntry([&](int body_b, int b, const Vec3& Jb) {
+      if (body_a == body_b) bodies[body_a]->AddNewtonBlock(a, b, scale * Ja * Jb.transpose());
+    });
+  });
+}
+
+void PrimalSolver::AssembleNewtonMatrices(const std::vector<IslandBody*>& bodies) {
+  for (IslandBody* body : bodies) body->ResetNewtonMatrix();
+  for (const CurvatureBlock& g : curvature_) bodies[g.body]->AddNewtonBlock(g.a, g.b, g.block);
+  for (int c = 0; c < rows_.size(); ++c) {
+    const ConstraintRow& row = rows_[c];
+    if (!in_pattern_[c] || row.friction_of == 2) continue;
+    if (row.friction_of == 1) {
+      // rho [J_1; J_2]^T D [J_1; J_2].
+      const Eigen::Matrix2d& D = d_disk_[c];
+      for (int p = 0; p < 2; ++p)
+        for (int q = 0; q < 2; ++q)
+          if (D(p, q) != 0.0) AddRowProduct(bodies, c + p, c + q, rho_[c] * D(p, q));
+      continue;
+    }
+    if (d_unit_[c] != 0.0) AddRowProduct(bodies, c, c, rho_[c] * d_unit_[c]);
+  }
+  try {
+    for (IslandBody* body : bodies) body->FactorNewtonMatrix();
+  } catch (const SimulationError&) {
+    // The curvature is only a metric: without it H = A + sum rho J^T D J is positive definite.
+    if (curvature_.empty()) throw;
+    curvature_.clear();
+    AssembleNewtonMatrices(bodies);
+  }
+}
+
+void PrimalSolver::AddRowHessianTimes(const std::vector<VecX>& u, std::vector<VecX>& out) const {
+  for (int c = 0; c < rows_.size(); ++c) {
+    const ConstraintRow& row = rows_[c];
+    if (row.friction_of == 2) continue;
+    if (row.friction_of == 1) {
+      const Eigen::Vector2d ju(rows_.CalcRowVelocity(c, u), rows_.CalcRowVelocity(c + 1, u));
+      const Eigen::Vector2d f = rho_[c] * (d_disk_[c] * ju);
+      for (int p = 0; p < 2; ++p)
+        rows_[c + p].ForEachEntry([&](int body, int block, const Vec3& J) {
+          out[body].segment<3>(3 * block) += f[p] * J;
+        });
+      continue;
+    }
+    if (d_unit_[c] == 0.0) continue;
+    const double f = rho_[c] * d_unit_[c] * rows_.CalcRowVelocity(c, u);
+    row.ForEachEntry(
+        [&](int body, int block, const Vec3& J) { out[body].segment<3>(3 * block) += f * J; });
+  }
+}
+
+void PrimalSolver::ApplyHessian(const std::vector<IslandBody*>& bodies, const std::vector<VecX>& u,
+                                std::vector<VecX>& out) {
+  for (size_t b = 0; b < bodies.size(); ++b) bodies[b]->ApplySystemMatrix(u[b], out[b]);
+  AddCurvatureTimes(u, out);
+  AddRowHessianTimes(u, out);
+  for (size_t b = 0; b < bodies.size(); ++b)
+    for (int i = 0; i < bodies[b]->num_blocks(); ++i)
+      if (!bodies[b]->is_free_block(i)) out[b].segment<3>(3 * i).setZero();
+}
+
+int PrimalSolver::SolveNewtonStep(const std::vector<IslandBody*>& bodies,
+                                  const PrimalSettings& settings) {
+  const size_t nb = bodies.size();
+  // Local rows only: H = N, one solve per body.
+  for (size_t b = 0; b < nb; ++b) {
+    d_[b] = -grad_[b];
+    bodies[b]->SolveNewton(d_[b]);
+  }
+  if (!coupled_) return 1;
+  // Coupled: PCG on H d = -grad from d = N^-1 (-grad), preconditioner N^-1.
+  ApplyHessian(bodies, d_, hp_);
+  for (size_t b = 0; b < nb; ++b) r_[b] = -grad_[b] - hp_[b];
+  const double rhs_norm = std::sqrt(Dot(grad_, grad_));
+  for (size_t b = 0; b < nb; ++b) {
+    z_[b] = r_[b];
+    bodies[b]->SolveNewton(z_[b]);
+    p_[b] = z_[b];
+  }
+  double rz = Dot(r_, z_);
+  int it = 1;
+  for (; it <= settings.max_pcg_iterations; ++it) {
+    if (std::sqrt(Dot(r_, r_)) <= settings.pcg_tolerance * rhs_norm || rz <= 0.0) break;
+    ApplyHessian(bodies, p_, hp_);
+    const double php = Dot(p_, hp_);
+    if (php <= 0.0) break;
+    const double alpha = rz / php;
+    for (size_t b = 0; b < nb; ++b) {
+      d_[b] += alpha * p_[b];
+      r_[b] -= alpha * hp_[b];
+      z_[b] = r_[b];
+      bodies[b]->SolveNewton(z_[b]);
+    }
+    const double rz_next = Dot(r_, z_);
+    const double beta = rz_next / rz;
+    rz = rz_next;
+    for (size_t b = 0; b < nb; ++b) p_[b] = z_[b] + beta * p_[b];
+  }
+  return it;
+}
+
+void PrimalSolver::CalcSlope(double alpha, double a0, double a1, double& slope,
+                             double& curvature) const {
+  // psi'(alpha) = a0 + alpha a1 - sum_c s_c Proj_c(y_c - alpha rho_c s_c);
+  // psi''(alpha) = a1 + sum_c rho_c s_c^T D_c s_c.
+  slope = a0 + alpha * a1;
+  curvature = a1;
+  for (int c = 0; c < rows_.size(); ++c) {
+    const ConstraintRow& row = rows_[c];
+    if (row.friction_of == 2 || (s_[c] == 0.0 && row.friction_of == 0)) continue;
+    if (row.friction_of == 1) {
+      const Eigen::Vector2d s(s_[c], s_[c + 1]);
+      const double radius = row.mu * std::max(0.0, lambda_bar_[c - 1]);
+      const Eigen::Vector2d y(lambda_bar_[c] - rho_[c] * (jv_[c] + alpha * s_[c]),
+                              lambda_bar_[c + 1] - rho_[c] * (jv_[c + 1] + alpha * s_[c + 1]));
+      Eigen::Matrix2d D;
+      const Eigen::Vector2d t = ProjectOnDisk(y, radius, &D);
+      slope -= s.dot(t);
+      curvature += rho_[c] * s.dot(D * s);
+      continue;
+    }
+    double D = 0.0;
+    const double y = lambda_bar_[c] - rho_[c] * (g0_[c] + jv_[c] + alpha * s_[c]);
+    slope -= s_[c] * ProjectOnInterval(y, LowerBound(row), UpperBound(row), &D);
+    curvature += rho_[c] * D * s_[c] * s_[c];
+  }
+}
+
+double PrimalSolver::SearchModelLine(const std::vector<IslandBody*>& bodies) {
+  const size_t nb = bodies.size();
+  // a0 = d^T A(v - v*), a1 = d^T (A + G) d, s_c = J_c d.
+  for (size_t b = 0; b < nb; ++b)
+    bodies[b]->ApplySystemMatrix(v_[b] - bodies[b]->v_star(), hp_[b]);
+  const double a0 = Dot(d_, hp_);
+  for (size_t b = 0; b < nb; ++b) bodies[b]->ApplySystemMatrix(d_[b], hp_[b]);
+  AddCurvatureTimes(d_, hp_);
+  const double a1 = Dot(d_, hp_);
+  for (int c = 0; c < rows_.size(); ++c) s_[c] = rows_.CalcRowVelocity(c, d_);
+  // psi is convex along d: bracket the root of psi' and close in by safeguarded Newton.
+  double slope, curvature;
+  CalcSlope(0.0, a0, a1, slope, curvature);
+  if (slope >= 0.0) return 0.0;  // not a descent direction (round-off at the minimum)
+  const double slope0 = slope;
+  double lo = 0.0, hi = 1.0;
+  CalcSlope(hi, a0, a1, slope, curvature);
+  for (int grow = 0; slope < 0.0 && grow < 20; ++grow) {
+    lo = hi;
+    hi *= 2.0;
+    CalcSlope(hi, a0, a1, slope, curvature);
+  }
+  if (slope < 0.0) return hi;
+  double alpha = hi;
+  for (int it = 0; it < 50; ++it) {
+    if (std::abs(slope) <= 1e-12 * std::abs(slope0)) break;
+    if (slope > 0.0) hi = alpha; else lo = alpha;
+    double next = curvature > 0.0 ? alpha - slope / curvature : 0.5 * (lo + hi);
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    alpha = next;
+    CalcSlope(alpha, a0, a1, slope, curvature);
+    if (hi - lo <= 1e-14 * hi) break;
+  }
+  return alpha;
+}
+
+double PrimalSolver::CalcMerit(const std::vector<IslandBody*>& bodies,
+                               const std::vector<VecX>& v) {
+  // Phi = 1/2 ||v - v*||_A^2 + sum_c P_c(y_c) / rho_c with g_c = C_c/h (friction: J_t v).
+  double phi = 0.0;
+  for (size_t b = 0; b < bodies.size(); ++b) {
+    work_[b] = v[b] - bodies[b]->v_star();
+    bodies[b]->ApplySystemMatrix(work_[b], hp_[b]);
+    phi += 0.5 * work_[b].dot(hp_[b]);
+  }
+  for (int c = 0; c < rows_.size(); ++c) {
+    const ConstraintRow& row = rows_[c];
+    if (rho_[c] <= 0.0 || row.friction_of == 2) continue;
+    if (row.friction_of == 1) {
+      const double radius = row.mu * std::max(0.0, lambda_bar_[c - 1]);
+      const Eigen::Vector2d y(lambda_bar_[c] - rho_[c] * rows_.CalcRowVelocity(c, v),
+                              lambda_bar_[c + 1] - rho_[c] * rows_.CalcRowVelocity(c + 1, v));
+      const double norm = y.norm();
+      phi += (norm <= radius ? 0.5 * norm * norm : radius * norm - 0.5 * radius * radius) / rho_[c];
+      continue;
+    }
+    const double y = lambda_bar_[c] - rho_[c] * (g0_[c] + rows_.CalcRowVelocity(c, v));
+    const double lo = LowerBound(row), hi = UpperBound(row);
+    double p = 0.5 * y * y;  // P(y) = integral_0^y Proj = y^2/2 inside [lo, hi], linear outside
+    if (y < lo) p = lo * y - 0.5 * lo * lo;
+    if (y > hi) p = hi * y - 0.5 * hi * hi;
+    phi += p / rho_[c];
+  }
+  return phi;
+}
+
+void PrimalSolver::CollectRowsAt(double h, const std::vector<IslandBody*>& bodies,
+                                 const std::vector<ConstraintSource*>& sources,
+                                 const std::vector<VecX>& v, const SqpSettings& settings,
+                                 StepStats& stats) {
+  const auto t = std::chrono::steady_clock::now();
+  const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
+  stats.violation_after = rows_.Collect(h, bodies, sources, v, distance_scale);
+  rows_.WarmStart(iterate_, lambda_bar_);
+  CalcPenalties(bodies, settings.primal);
+  for (size_t b = 0; b < bodies.size(); ++b) v_[b] = v[b];
+  LinearizeRows(h, bodies);
+  jv_.resize(rows_.size());
+  s_.setZero(rows_.size());
+  stats.ms_rows += MsSince(t);
+}
+
+bool PrimalSolver::TakeNewtonStep(double h, const std::vector<IslandBody*>& bodies,
+                                  const std::vector<ConstraintSource*>& sources,
+                                  const SqpSettings& settings, StepStats& stats) {
+  const PrimalSettings& primal = settings.primal;
+  const size_t nb = bodies.size();
+  CalcProjectedMultipliers();
+  CalcGradient(bodies);
+  if (primal.curvature) CollectCurvature(h, bodies, sources);
+  else curvature_.clear();
+  AssembleNewtonMatrices(bodies);
+  stats.pcg_iterations += SolveNewtonStep(bodies, primal);
+  stats.newton_iterations++;
+
+  // Newton decrement -grad^T d against the scale ||v - v*||_A^2.
+  const double decrement = -Dot(grad_, d_);
+  for (size_t b = 0; b < nb; ++b) {
+    work_[b] = v_[b] - bodies[b]->v_star();
+    bodies[b]->ApplySystemMatrix(work_[b], hp_[b]);
+  }
+  const double scale = Dot(work_, hp_);
+  if (!(decrement > primal.newton_tolerance * std::max(scale, 1e-300))) return false;
+  double alpha = SearchModelLine(bodies);
+  if (alpha <= 0.0) return false;
+  // Armijo backtracking on the nonlinear Phi (rows re-evaluated at each trial).
+  const double phi0 = CalcMerit(bodies, v_);
+  base_.Save(*this);
+  for (int halving = 0;; ++halving) {
+    for (size_t b = 0; b < nb; ++b) v_trial_[b] = base_.v[b] + alpha * d_[b];
+    CollectRowsAt(h, bodies, sources, v_trial_, settings, stats);
+    if (CalcMerit(bodies, v_trial_) <= phi0 - 1e-4 * alpha * decrement) {
+      return true;
+    }
+    if (halving >= settings.max_line_search_halvings) break;
+    alpha *= 0.5;
+  }
+  // No sufficient decrease (round-off at the minimum): stay at v.
+  base_.Restore(*this);
+  return false;
+}
+
+bool PrimalSolver::WarmStartVelocities(const std::vector<IslandBody*>& bodies) {
+  // v = v* + A^-1 J^T lambda_bar (the previous step's impulses on this step's rows).
+  if (rows_.empty() || lambda_bar_.cwiseAbs().maxCoeff() == 0.0) return false;
+  for (size_t b = 0; b < bodies.size(); ++b) work_[b].setZero();
+  for (int c = 0; c < rows_.size(); ++c)
+    rows_[c].ForEachEntry([&](int body, int block, const Vec3& J) {
+      work_[body].segment<3>(3 * block) += lambda_bar_[c] * J;
+    });
+  for (size_t b = 0; b < bodies.size(); ++b) {
+    bodies[b]->SolveSystemColumns(work_[b]);
+    v_trial_[b] = v_[b] + work_[b];
+  }
+  return true;
+}
+
+void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
+                         const std::vector<ConstraintSource*>& sources,
+                         const SqpSettings& settings, KeyedMultipliers& warm, StepStats& stats) {
+  const PrimalSettings& primal = settings.primal;
+  const size_t nb = bodies.size();
+  for (auto* list : {&v_, &v_trial_, &d_, &grad_, &work_, &r_, &z_, &p_, &hp_}) list->resize(nb);
+  std::vector<VecX> start(nb);
+  for (size_t b = 0; b < nb; ++b) {
+    start[b] = bodies[b]->v();
+    for (auto* list : {&v_, &v_trial_, &d_, &grad_, &work_, &r_, &z_, &p_, &hp_})
+      (*list)[b].setZero(start[b].size());
+  }
+  iterate_ = settings.warm_start ? warm : KeyedMultipliers();
+  const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
+  CollectRowsAt(h, bodies, sources, start, settings, stats);
+  stats.violation_before = stats.violation_after;
+  if (WarmStartVelocities(bodies)) CollectRowsAt(h, bodies, sources, v_trial_, settings, stats);
+  for (int k = 0; !rows_.empty(); ++k) {
+    // Certificate of (v, lambda_bar) at the rows of v.
+    rows_.CountTypes(stats);
+    const auto t = std::chrono::steady_clock::now();
+    const KktResiduals kkt =
+        CalcKktResiduals(bodies, rows_, lambda_bar_, v_, h, distance_scale, scratch_);
+    RecordKkt(kkt, stats);
+    stats.converged = IsCertified(kkt, settings.violation_tolerance, settings.stationarity_tolerance);
+    if (stats.converged || k >= primal.max_iterations) break;
+    // Minimize Phi for this lambda_bar, then the multiplier update lambda_bar <- Proj(y(v)).
+    for (int it = 0; it < primal.max_newton_iterations; ++it)
+      if (!TakeNewtonStep(h, bodies, sources, settings, stats)) break;
+    CalcProjectedMultipliers();
+    lambda_bar_ = lambda_;
+    rows_.Store(lambda_bar_, iterate_);
+    stats.sqp_iterations = k + 1;
+    stats.ms_solve += MsSince(t);
+  }
+  if (rows_.empty()) iterate_.clear();
+  for (size_t b = 0; b < nb; ++b) bodies[b]->set_v(v_[b]);
+  warm = iterate_;
+  stats.islands_primal++;
+}
+
+}  // namespace taut

@@ -1,0 +1,132 @@
+// The primal island solver (DESIGN.md "One step", stage 6, primal path): an augmented-Lagrangian
+// SQP on the island's velocities, each linearized problem minimized by Newton's method with an
+// exact line search, the multipliers updated by projection. Used where the papers' dual PGS
+// cannot converge: more limit rows than free DOFs make W = J A^-1 J^T rank-deficient, while the
+// primal Newton matrix A + G + sum rho J^T D J stays positive definite for any redundancy.
+#pragma once
+
+#include <vector>
+
+#include "constraints/island_rows.h"
+#include "constraints/kkt_certificate.h"
+#include "constraints/sqp_settings.h"
+
+namespace taut {
+
+// Solves min 1/2 ||v - v*||_A^2  s.t.  C(x0 + h v) >= 0 (bilateral: = 0, friction on the disk)
+// by the method of multipliers on the augmented Lagrangian
+//   Phi(v) = 1/2 ||v - v*||_A^2 + sum_c P_c(y_c(v)) / rho_c,   y_c = lambda_bar_c - rho_c g_c(v),
+//   g_c = C_c(x0 + h v)/h (friction: g = J_t v), P_c(y) = integral of Proj_c (1/2 max(0, y)^2 for
+//   unilateral rows; Huber-like for intervals [lo, hi] and the disk |y| <= mu lambda_bar_n):
+//   for k = 0, 1, ...: minimize Phi over v by Newton: rows, C, J at v; lambda_c = Proj_c(y_c);
+//       grad = A(v - v*) - J^T lambda;  H = A + sum rho_c J_c^T D_c J_c + G  (D = dProj/dy,
+//       G = h sum lambda_c [-d^2 C_c/dx^2]_+ the row curvature with negative modes clamped);
+//       d = -H^-1 grad; alpha from the exact line search of the linearized model, backtracked
+//       (Armijo) on the nonlinear Phi;
+//     then lambda_bar_c <- Proj_c(y_c(v)),
+//   until the KKT residuals at (v, lambda_bar) are within tolerance (constraints/kkt_certificate.h).
+// rho_c = penalty_scale / w_c with w_c = sum_i J_ci^T M_i^-1 J_ci (a diagonal Delassus estimate
+// from lumped masses; no W is formed). Rows local to one body (strain, energy, node contact) keep
+// H on A's sparsity pattern: one sparse factorization per Newton iteration. Rows that couple two
+// bodies (rigid contacts, joints, deformable-deformable) enter H matrix-free and the step is
+// solved by PCG preconditioned with the per-body factors.
+class PrimalSolver {
+ public:
+  // One step h for the island `bodies` (entered with v = v*, left with the constrained v).
+  // `warm` holds the multipliers by row key from the previous step (read and rewritten).
+  void Solve(double h, const std::vector<IslandBody*>& bodies,
+             const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
+             KeyedMultipliers& warm, StepStats& stats);
+
+ private:
+  // Stage: rows, C and J at v (into rows_), lambda_bar by key, penalties, linearization.
+  void CollectRowsAt(double h, const std::vector<IslandBody*>& bodies,
+                     const std::vector<ConstraintSource*>& sources, const std::vector<VecX>& v,
+                     const SqpSettings& settings, StepStats& stats);
+  // v = v* + A^-1 J^T lambda_bar into v_trial_ (false when there is no warm multiplier).
+  bool WarmStartVelocities(const std::vector<IslandBody*>& bodies);
+  // rho_c of every row from the diagonal Delassus estimate (friction rows: their normal's).
+  void CalcPenalties(const std::vector<IslandBody*>& bodies, const PrimalSettings& settings);
+  // g0_c with g_c(v + dv) = g0_c + J_c (v + dv) at the collected rows, and which rows H can hold
+  // on the bodies' patterns.
+  void LinearizeRows(double h, const std::vector<IslandBody*>& bodies);
+  // Stage: G = h sum lambda_c [-d^2 C_c]_+ as node blocks, from the sources of limit rows.
+  void CollectCurvature(double h, const std::vector<IslandBody*>& bodies,
+                        const std::vector<ConstraintSource*>& sources);
+  // Stage: one Newton step on Phi from v_ (rows collected at v_); returns false when v_ is
+  // stationary (Newton decrement below tolerance) and nothing moved.
+  bool TakeNewtonStep(double h, const std::vector<IslandBody*>& bodies,
+                      const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
+                      StepStats& stats);
+  // lambda_c = Proj_c(y_c(v)) and D_c at v (row velocities jv_ = J v).
+  void CalcProjectedMultipliers();
+  // grad = A(v - v*) - J^T lambda on free blocks.
+  void CalcGradient(const std::vector<IslandBody*>& bodies);
+  // N_b = A_b + G_b + sum rho D J^T J (same-body blocks of rows held on the pattern), factored.
+  void AssembleNewtonMatrices(const std::vector<IslandBody*>& bodies);
+  // d = -H^-1 grad: one solve per body when H = N, else PCG with N as preconditioner. Returns the
+  // PCG iterations (1 for the direct solve).
+  int SolveNewtonStep(const std::vector<IslandBody*>& bodies, const PrimalSettings& settings);
+  // out = H u (exact operator, matrix-free rows).
+  void ApplyHessian(const std::vector<IslandBody*>& bodies, const std::vector<VecX>& u,
+                    std::vector<VecX>& out);
+  // out_b += G_b u_b.
+  void AddCurvatureTimes(const std::vector<VecX>& u, std::vector<VecX>& out) const;
+  // Step length minimizing the linearized model of Phi along d (root of its convex slope).
+  double SearchModelLine(const std::vector<IslandBody*>& bodies);
+  // Slope psi'(alpha) and curvature psi''(alpha) of the linearized model along d.
+  void CalcSlope(double alpha, double a0, double a1, double& slope, double& curvature) const;
+  // Phi at the collected rows and velocities v (lambda_bar, rho as collected).
+  double CalcMerit(const std::vector<IslandBody*>& bodies, const std::vector<VecX>& v);
+  // Adds scale * J_p^T J_q (same-body blocks) to the bodies' Newton matrices.
+  void AddRowProduct(const std::vector<IslandBody*>& bodies, int p, int q, double scale);
+  // out += rho D J^T (J u) over the rows (H's row part, matrix-free).
+  void AddRowHessianTimes(const std::vector<VecX>& u, std::vector<VecX>& out) const;
+
+  IslandRows rows_;
+  KeyedMultipliers iterate_;   // lambda_bar of this step by key
+  VecX lambda_bar_, lambda_;   // estimates, and Proj(y(v)) at the Newton iterate
+  VecX rho_, g0_, jv_, s_;     // penalties, g_c(v) = g0 + J v, J v, J d
+  VecX d_unit_;                // D_c of scalar rows (0 or 1)
+  std::vector<Eigen::Matrix2d> d_disk_;  // D of a friction pair, on its first tangent row
+  std::vector<char> in_pattern_;         // row's same-body blocks fit the patterns
+  bool coupled_ = false;                 // some row is two-sided or off-pattern: PCG
+  struct CurvatureBlock {
+    int body, a, b;
+    Mat3 block;
+  };
+  std::vector<CurvatureBlock> curvature_;
+  std::vector<VecX> v_, v_trial_, d_, grad_, work_, r_, z_, p_, hp_;
+  // The rows and velocities of the line search's base point (restored when no trial is taken).
+  struct BasePoint {
+    IslandRows rows;
+    VecX lambda_bar, rho, g0;
+    std::vector<char> in_pattern;
+    bool coupled = false;
+    std::vector<VecX> v;
+    void Save(const PrimalSolver& s) {
+      rows = s.rows_;
+      lambda_bar = s.lambda_bar_;
+      rho = s.rho_;
+      g0 = s.g0_;
+      in_pattern = s.in_pattern_;
+      coupled = s.coupled_;
+      v = s.v_;
+    }
+    void Restore(PrimalSolver& s) const {
+      s.rows_ = rows;
+      s.lambda_bar_ = lambda_bar;
+      s.rho_ = rho;
+      s.g0_ = g0;
+      s.in_pattern_ = in_pattern;
+      s.coupled_ = coupled;
+      s.v_ = v;
+      s.jv_.resize(s.rows_.size());
+      s.s_.setZero(s.rows_.size());
+    }
+  };
+  BasePoint base_;
+  VecX scratch_;
+};
+
+}  // namespace taut

@@ -1,0 +1,188 @@
+// The primal island solver (constraints/primal_solver.h) against the papers' dual path and
+// against physics: same answer where both converge, limits hard at convergence, Coulomb friction
+// exact (stick below the cone, slide on it), coupled rigid bodies (PCG path), the certificate.
+#include "constraints/primal_solver.h"
+
+#include <gtest/gtest.h>
+
+#include <BulletCollision/CollisionShapes/btBoxShape.h>
+#include <BulletCollision/CollisionShapes/btStaticPlaneShape.h>
+
+#include "bullet_bridge/eigen_bullet.h"
+#include "constraints/island_solver.h"
+#include "demos/scenes/bullet_world_holder.h"
+#include "plugin/box_tet_mesher.h"
+
+namespace taut {
+namespace {
+
+// A soft bar fixed at x = 0, sagging under gravity against isotropic strain limits.
+struct SaggingBar {
+  BulletWorldHolder holder;
+  DeformableBody* body = nullptr;
+  StrainLimitConstraint* limit = nullptr;
+
+  SaggingBar(IslandSolverKind solver, double s_min, double s_max) {
+    DeformableBodySettings settings;
+    settings.name = "bar";
+    settings.material = {5e3, 0.3, 1000.0};
+    body = holder.world.AddTetBody(MakeBoxTetMesh(Vec3(0.4, 0.1, 0.1), 4, 1, 1), settings);
+    body->FixNodesWhere([](const Vec3& X) { return X.x() < 1e-9; });
+    limit = holder.world.SetStrainLimits(body, StrainLimitSettings::Isotropic(s_min, s_max));
+    holder.world.mutable_solver_settings().solver = solver;
+  }
+  // Steps and returns the number of unconverged steps.
+  int Run(int steps) {
+    int unconverged = 0;
+    for (int step = 0; step < steps; ++step) {
+      holder.world.stepSimulation(1.0 / 240.0, 1, 1.0 / 240.0);
+      unconverged += holder.world.last_step_stats().converged ? 0 : 1;
+    }
+    return unconverged;
+  }
+};
+
+TEST(PrimalSolverTest, SameFirstConstrainedStepAsTheDualPath) {
+  // One step from the same state: both paths solve the same convex-in-v problem to tolerance, so
+  // the velocities agree to the tolerance's order.
+  SaggingBar dual(IslandSolverKind::kDual, 0.99, 1.01), primal(IslandSolverKind::kPrimal, 0.99, 1.01);
+  // Give both a stretching velocity that violates the limits in one step.
+  VecX v = VecX::Zero(3 * dual.body->num_nodes());
+  for (int i = 0; i < dual.body->num_nodes(); ++i)
+    if (dual.body->node_kind(i) == NodeKind::kFree)
+      v[3 * i] = 5.0 * dual.body->model().rest_positions()[3 * i];  // 2 % stretch in one step
+  dual.body->set_v(v);
+  primal.body->set_v(v);
+  dual.Run(1);
+  primal.Run(1);
+  const StepStats& ds = dual.holder.world.last_step_stats();
+  const StepStats& ps = primal.holder.world.last_step_stats();
+  EXPECT_GT(ps.rows_strain, 0);
+  EXPECT_EQ(ps.islands_primal, 1);
+  EXPECT_EQ(ds.islands_dual, 1);
+  EXPECT_TRUE(ps.converged);
+  EXPECT_GT(ps.newton_iterations, 0);
+  EXPECT_LE(primal.limit->CalcMaxViolation(primal.body->x()), 1e-3);
+  const double scale = v.cwiseAbs().maxCoeff();
+  EXPECT_LT((primal.body->v() - dual.body->v()).cwiseAbs().maxCoeff(), 2e-2 * scale)
+      << "dual converged: " << ds.converged;
+}
+
+TEST(PrimalSolverTest, TightLimitsHoldEveryStepWithACertificate) {
+  // +-1 % on a 5 kPa bar (unlimited it sags tens of percent): every step converged, every
+  // element's principal stretches inside the limits to the tolerance.
+  SaggingBar bar(IslandSolverKind::kPrimal, 0.99, 1.01);
+  int unconverged = 0;
+  double worst = 0.0, worst_complementarity = 0.0;
+  for (int step = 0; step < 120; ++step) {
+    unconverged += bar.Run(1);
+    worst = std::max(worst, bar.limit->CalcMaxViolation(bar.body->x()));
+    worst_complementarity =
+        std::max(worst_complementarity, bar.holder.world.last_step_stats().kkt_complementarity);
+  }
+  EXPECT_EQ(unconverged, 0);
+  EXPECT_LE(worst, 1.5e-3);  // C units: 1e-3 of the 1 % limit, plus the step's own motion
+  EXPECT_LE(worst_complementarity, 1e-3);
+  EXPECT_GT(bar.holder.world.last_step_stats().rows_strain, 0);
+}
+
+// A soft cube resting on a plane tilted by `degrees` about y (downhill +x'), friction mu (times
+// the plane's 1.0); returns the cube's mean displacement down the slope over 0.5 s [m].
+double SlideOnIncline(double mu, double degrees, IslandSolverKind solver) {
+  BulletWorldHolder holder;
+  const double theta = degrees * M_PI / 180.0;
+  const Vec3 normal(std::sin(theta), 0.0, std::cos(theta));
+  const Vec3 downhill(std::cos(theta), 0.0, -std::sin(theta));
+  holder.AddRigidBody(std::make_unique<btStaticPlaneShape>(ToBullet(normal), 0), 0.0,
+                      btVector3(0, 0, 0), 1.0);
+  DeformableBodySettings settings;
+  settings.name = "cube";
+  settings.material = {1e6, 0.3, 1000.0};
+  settings.friction = mu;
+  TetMesh mesh = MakeBoxTetMesh(Vec3(0.1, 0.1, 0.1), 2, 2, 2, Vec3(-0.05, -0.05, 1e-4));
+  Mat3 rotation;
+  rotation << downhill, Vec3::UnitY(), normal;
+  for (Vec3& node : mesh.nodes) node = rotation * node;
+  DeformableBody* body = holder.world.AddTetBody(mesh, settings);
+  holder.world.mutable_solver_settings().solver = solver;
+  auto position = [&]() {
+    double s = 0.0;
+    for (int i = 0; i < body->num_nodes(); ++i) s += downhill.dot(body->node_position(i));
+    return s / body->num_nodes();
+  };
+  const double start = position();
+  for (int step = 0; step < 120; ++step) holder.world.stepSimulation(1.0 / 240, 1, 1.0 / 240);
+  return position() - start;
+}
+
+TEST(PrimalSolverTest, CoulombFrictionSticksInsideTheConeAndSlidesOnIt) {
+  // tan(20 deg) = 0.36: mu = 0.5 sticks (elastic settling only); mu = 0.1 slides with
+  // a = g (sin - mu cos) = 2.43 m/s^2 from rest: 0.30 m in 0.5 s.
+  const double stick = SlideOnIncline(0.5, 20.0, IslandSolverKind::kPrimal);
+  const double slide = SlideOnIncline(0.1, 20.0, IslandSolverKind::kPrimal);
+  const double dual_slide = SlideOnIncline(0.1, 20.0, IslandSolverKind::kDual);
+  std::printf("incline 20 deg: moved mu 0.5 %.2e m, mu 0.1 %.4f m (dual path %.4f m)\n", stick,
+              slide, dual_slide);
+  EXPECT_LT(std::abs(stick), 1e-3);
+  const double theta = 20 * M_PI / 180;
+  const double expected = 0.5 * 9.81 * (std::sin(theta) - 0.1 * std::cos(theta)) * 0.25;
+  EXPECT_NEAR(slide, expected, 0.1 * expected);
+  EXPECT_NEAR(slide, dual_slide, 0.02 * expected);
+}
+
+// A 2 kg box dropped 0.5 mm onto a limited soft block fixed at its base; returns the box's height
+// after 1 s and after 2 s, and the unconverged steps of the last second.
+struct BoxOnBlock {
+  double z_1s = 0.0, z_2s = 0.0;
+  int unconverged = 0, coupled = 0;
+};
+BoxOnBlock RestBoxOnBlock(IslandSolverKind solver) {
+  BulletWorldHolder holder;
+  holder.world.mutable_solver_settings().solver = solver;
+  DeformableBodySettings settings;
+  settings.name = "block";
+  settings.material = {2e4, 0.3, 1000.0};
+  settings.mass_damping = 2.0;
+  DeformableBody* block =
+      holder.world.AddTetBody(MakeBoxTetMesh(Vec3(0.2, 0.2, 0.1), 4, 4, 2), settings);
+  block->FixNodesWhere([](const Vec3& X) { return X.z() < 1e-9; });
+  holder.world.SetStrainLimits(block, StrainLimitSettings::Isotropic(0.95, 1.05));
+  btRigidBody* box = holder.AddRigidBody(std::make_unique<btBoxShape>(btVector3(0.06, 0.06, 0.05)),
+                                         2.0, btVector3(0.1, 0.1, 0.1505));
+  BoxOnBlock result;
+  for (int step = 0; step < 480; ++step) {
+    holder.world.stepSimulation(1.0 / 240, 1, 1.0 / 240);
+    const StepStats& stats = holder.world.last_step_stats();
+    if (step >= 240) result.unconverged += stats.converged ? 0 : 1;
+    result.coupled = std::max(result.coupled, stats.rigid_bodies_coupled);
+    if (step == 239) result.z_1s = box->getWorldTransform().getOrigin().z();
+  }
+  result.z_2s = box->getWorldTransform().getOrigin().z();
+  return result;
+}
+
+TEST(PrimalSolverTest, RigidBoxOnASoftBlockComesToRest) {
+  // Two-way coupled island (PCG path): the box is carried by the block's contact rows and
+  // settles; rest is rest (< 0.1 mm over the last second), every step converged.
+  const BoxOnBlock primal = RestBoxOnBlock(IslandSolverKind::kPrimal);
+  const BoxOnBlock dual = RestBoxOnBlock(IslandSolverKind::kDual);
+  std::printf("box on soft block, z at 1 s -> 2 s: primal %.6f -> %.6f m (%d unconverged), dual "
+              "%.6f -> %.6f m (%d unconverged)\n",
+              primal.z_1s, primal.z_2s, primal.unconverged, dual.z_1s, dual.z_2s, dual.unconverged);
+  EXPECT_EQ(primal.coupled, 1);
+  EXPECT_EQ(primal.unconverged, 0);
+  EXPECT_LT(std::abs(primal.z_2s - primal.z_1s), 1e-4);
+  EXPECT_GT(primal.z_2s, 0.14);  // carried by the block, not sunk through it
+  EXPECT_NEAR(primal.z_2s, dual.z_2s, 1e-3);
+}
+
+TEST(PrimalSolverTest, AutoChoiceFollowsRowsPerDof) {
+  EXPECT_EQ(IslandSolver::ChooseAuto(0, 300), IslandSolverKind::kDual);
+  EXPECT_EQ(IslandSolver::ChooseAuto(50, 300), IslandSolverKind::kDual);
+  EXPECT_EQ(IslandSolver::ChooseAuto(200, 300), IslandSolverKind::kPrimal);
+  // A failed dual step sends the island to the primal path for a while.
+  EXPECT_EQ(IslandSolver::ChooseAuto(50, 300, 3), IslandSolverKind::kPrimal);
+}
+
+}  // namespace
+}  // namespace taut
