@@ -96,11 +96,21 @@ void PrimalSolver::LinearizeRows(double h, const std::vector<IslandBody*>& bodie
     const ConstraintRow& row = rows_[c];
     // g_c(v_ + dv) = C_c/h + J_c dv = g0_c + J_c (v_ + dv); friction rows target J_t v = 0.
     g0_[c] = row.friction_of > 0 ? 0.0 : row.C / h - rows_.CalcRowVelocity(c, v_);
-    row.ForEachEntry([&](int body_a, int a, const Vec3&) {
-      row.ForEachEntry([&](int body_b, int b, const Vec3&) {
-        if (body_a == body_b && !bodies[body_a]->IsInNewtonPattern(a, b)) in_pattern_[c] = 0;
+    // Rows of one element are adjacent and share its nodes: the previous row's answer holds.
+    const ConstraintRow* previous = c > 0 ? &rows_[c - 1] : nullptr;
+    const bool same_nodes = previous && previous->body == row.body && previous->body2 == row.body2 &&
+                            previous->num_nodes == row.num_nodes &&
+                            previous->num_nodes2 == row.num_nodes2 &&
+                            previous->nodes == row.nodes && previous->nodes2 == row.nodes2;
+    if (same_nodes) {
+      in_pattern_[c] = in_pattern_[c - 1];
+    } else {
+      row.ForEachEntry([&](int body_a, int a, const Vec3&) {
+        row.ForEachEntry([&](int body_b, int b, const Vec3&) {
+          if (body_a == body_b && !bodies[body_a]->IsInNewtonPattern(a, b)) in_pattern_[c] = 0;
+        });
       });
-    });
+    }
     const bool two_sided = row.body2 >= 0 && row.body2 != row.body;
     if (two_sided || !in_pattern_[c]) coupled_ = true;
   }
@@ -120,7 +130,17 @@ void PrimalSolver::CollectCurvature(double h, const std::vector<IslandBody*>& bo
     any = true;
   }
   if (!any) return;
+  // Rows of one element are adjacent: a block already listed for the element's node pair (within
+  // the last 64 entries, one element's worth) is summed into, not repeated.
   CurvatureList sink([this](int body, int a, int b, const Mat3& block) {
+    const size_t first = curvature_.size() > 64 ? curvature_.size() - 64 : 0;
+    for (size_t i = curvature_.size(); i-- > first;) {
+      CurvatureBlock& g = curvature_[i];
+      if (g.body == body && g.a == a && g.b == b) {
+        g.block += block;
+        return;
+      }
+    }
     curvature_.push_back({body, a, b, block});
   });
   const IslandIterate iterate(h, bodies, v_, rows_.positions());
@@ -184,6 +204,9 @@ void PrimalSolver::AddRowProduct(const std::vector<IslandBody*>& bodies, int p, 
 void PrimalSolver::AssembleNewtonMatrices(const std::vector<IslandBody*>& bodies) {
   for (IslandBody* body : bodies) body->ResetNewtonMatrix();
   for (const CurvatureBlock& g : curvature_) bodies[g.body]->AddNewtonBlock(g.a, g.b, g.block);
+  // Rows of one element are adjacent and share its nodes: their rho J^T J are summed into one
+  // dense element block first and scattered once (group_ below).
+  group_.Clear();
   for (int c = 0; c < rows_.size(); ++c) {
     const ConstraintRow& row = rows_[c];
     if (!in_pattern_[c] || row.friction_of == 2) continue;
@@ -195,8 +218,18 @@ void PrimalSolver::AssembleNewtonMatrices(const std::vector<IslandBody*>& bodies
           if (D(p, q) != 0.0) AddRowProduct(bodies, c + p, c + q, rho_[c] * D(p, q));
       continue;
     }
-    if (d_unit_[c] != 0.0) AddRowProduct(bodies, c, c, rho_[c] * d_unit_[c]);
+    if (d_unit_[c] == 0.0) continue;
+    if (row.body2 >= 0 && row.body2 != row.body) {
+      AddRowProduct(bodies, c, c, rho_[c] * d_unit_[c]);
+      continue;
+    }
+    if (!group_.Matches(row)) {
+      group_.Scatter(bodies);
+      group_.Start(row);
+    }
+    group_.Add(row, rho_[c] * d_unit_[c]);
   }
+  group_.Scatter(bodies);
   try {
     for (IslandBody* body : bodies) body->FactorNewtonMatrix();
   } catch (const SimulationError&) {
@@ -205,6 +238,38 @@ void PrimalSolver::AssembleNewtonMatrices(const std::vector<IslandBody*>& bodies
     curvature_.clear();
     AssembleNewtonMatrices(bodies);
   }
+}
+
+void PrimalSolver::RowGroup::Clear() { num_nodes = 0; }
+
+bool PrimalSolver::RowGroup::Matches(const ConstraintRow& row) const {
+  if (num_nodes == 0 || row.body != body || row.num_nodes + row.num_nodes2 != num_nodes) return false;
+  for (int n = 0; n < row.num_nodes; ++n)
+    if (row.nodes[n] != nodes[n]) return false;
+  for (int n = 0; n < row.num_nodes2; ++n)
+    if (row.nodes2[n] != nodes[row.num_nodes + n]) return false;
+  return true;
+}
+
+void PrimalSolver::RowGroup::Start(const ConstraintRow& row) {
+  body = row.body;
+  num_nodes = 0;
+  row.ForEachEntry([&](int, int block, const Vec3&) { nodes[num_nodes++] = block; });
+  block.setZero(3 * num_nodes, 3 * num_nodes);
+}
+
+void PrimalSolver::RowGroup::Add(const ConstraintRow& row, double scale) {
+  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6 * kMaxRowNodes, 1> J(3 * num_nodes);
+  int n = 0;
+  row.ForEachEntry([&](int, int, const Vec3& Jn) { J.segment<3>(3 * n++) = Jn; });
+  block.noalias() += scale * J * J.transpose();
+}
+
+void PrimalSolver::RowGroup::Scatter(const std::vector<IslandBody*>& bodies) {
+  for (int a = 0; a < num_nodes; ++a)
+    for (int b = 0; b < num_nodes; ++b)
+      bodies[body]->AddNewtonBlock(nodes[a], nodes[b], block.block<3, 3>(3 * a, 3 * b));
+  num_nodes = 0;
 }
 
 void PrimalSolver::AddRowHessianTimes(const std::vector<VecX>& u, std::vector<VecX>& out) const {
@@ -462,11 +527,15 @@ void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     // Certificate of (v, lambda_bar) at the rows of v.
     rows_.CountTypes(stats);
     const auto t = std::chrono::steady_clock::now();
+    const double ms_rows_before = stats.ms_rows;  // row collection inside is ms_rows, not ms_solve
     const KktResiduals kkt =
         CalcKktResiduals(bodies, rows_, lambda_bar_, v_, h, distance_scale, scratch_);
     RecordKkt(kkt, stats);
     stats.converged = IsCertified(kkt, settings.violation_tolerance, settings.stationarity_tolerance);
-    if (stats.converged || k >= primal.max_iterations) break;
+    if (stats.converged || k >= primal.max_iterations) {
+      stats.ms_solve += MsSince(t);
+      break;
+    }
     // Minimize Phi for this lambda_bar, then the multiplier update lambda_bar <- Proj(y(v)).
     for (int it = 0; it < primal.max_newton_iterations; ++it)
       if (!TakeNewtonStep(h, bodies, sources, settings, stats)) break;
@@ -474,7 +543,7 @@ void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     lambda_bar_ = lambda_;
     rows_.Store(lambda_bar_, iterate_);
     stats.sqp_iterations = k + 1;
-    stats.ms_solve += MsSince(t);
+    stats.ms_solve += MsSince(t) - (stats.ms_rows - ms_rows_before);
   }
   if (rows_.empty()) iterate_.clear();
   for (size_t b = 0; b < nb; ++b) bodies[b]->set_v(v_[b]);

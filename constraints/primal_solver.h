@@ -5,6 +5,7 @@
 // primal Newton matrix A + G + sum rho J^T D J stays positive definite for any redundancy.
 #pragma once
 
+#include <array>
 #include <vector>
 
 #include "constraints/island_rows.h"
@@ -96,6 +97,20 @@ class PrimalSolver {
     Mat3 block;
   };
   std::vector<CurvatureBlock> curvature_;
+  // Consecutive rows on the same nodes of one body (one element's rows): their summed
+  // rho D J^T J as one dense block, scattered into the Newton matrix once.
+  struct RowGroup {
+    int body = -1, num_nodes = 0;
+    std::array<int, 2 * kMaxRowNodes> nodes{};
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6 * kMaxRowNodes, 6 * kMaxRowNodes>
+        block;
+    void Clear();
+    bool Matches(const ConstraintRow& row) const;
+    void Start(const ConstraintRow& row);
+    void Add(const ConstraintRow& row, double scale);
+    void Scatter(const std::vector<IslandBody*>& bodies);
+  };
+  RowGroup group_;
   std::vector<VecX> v_, v_trial_, d_, grad_, work_, r_, z_, p_, hp_;
   // The rows and velocities of the line search's base point (restored when no trial is taken).
   struct BasePoint {
