@@ -77,27 +77,42 @@ void ImplicitSystem::Assemble(const ElementModel& model, const VecX& mass, doubl
   model.AddScaledStiffness(c_K, element_map_, values);
 }
 
-void ImplicitSystem::Factor(const std::string& body) {
-  if (num_free_dofs() == 0) return;
-  const bool ok = use_cholmod_ ? cholmod_.Factorize(A_)
-                               : ldlt_.Factorize(A_) && ldlt_.num_negative_pivots() == 0;
-  if (!ok)
-    throw SimulationError(internal::Concat("body '", body,
-                                           "': system matrix A = M + hD + h^2 K is not positive "
-                                           "definite (stage: factorization)"));
+bool ImplicitSystem::FactorWith(const Eigen::SparseMatrix<double>& M, SparseLdlt& ldlt,
+                                CholmodCholesky& cholmod) const {
+  return use_cholmod_ ? cholmod.Factorize(M) : ldlt.Factorize(M) && ldlt.num_negative_pivots() == 0;
 }
 
-void ImplicitSystem::Solve(Eigen::Ref<VecX> rhs) const {
+void ImplicitSystem::SolveWith(const SparseLdlt& ldlt, const CholmodCholesky& cholmod,
+                               Eigen::Ref<VecX> rhs) const {
   const int n = num_free_dofs();
   for (int i = 0; i < n; ++i) rhs_free_[i] = rhs[free_to_dof_[i]];
   rhs.setZero();
   if (n == 0) return;
   if (use_cholmod_)
-    cholmod_.Solve(rhs_free_);
+    cholmod.Solve(rhs_free_);
   else
-    ldlt_.Solve(rhs_free_);
+    ldlt.Solve(rhs_free_);
   for (int i = 0; i < n; ++i) rhs[free_to_dof_[i]] = rhs_free_[i];
 }
+
+void ImplicitSystem::MultiplyWith(const Eigen::SparseMatrix<double>& M, const VecX& v,
+                                  VecX& out) const {
+  const int n = num_free_dofs();
+  for (int i = 0; i < n; ++i) rhs_free_[i] = v[free_to_dof_[i]];
+  product_free_.noalias() = M * rhs_free_;
+  out.setZero(v.size());
+  for (int i = 0; i < n; ++i) out[free_to_dof_[i]] = product_free_[i];
+}
+
+void ImplicitSystem::Factor(const std::string& body) {
+  if (num_free_dofs() == 0) return;
+  if (!FactorWith(A_, ldlt_, cholmod_))
+    throw SimulationError(internal::Concat("body '", body,
+                                           "': system matrix A = M + hD + h^2 K is not positive "
+                                           "definite (stage: factorization)"));
+}
+
+void ImplicitSystem::Solve(Eigen::Ref<VecX> rhs) const { SolveWith(ldlt_, cholmod_, rhs); }
 
 void ImplicitSystem::SolveColumns(Eigen::Ref<MatX> rhs) const {
   const int n = num_free_dofs();
@@ -114,13 +129,7 @@ void ImplicitSystem::SolveColumns(Eigen::Ref<MatX> rhs) const {
   for (int i = 0; i < n; ++i) rhs.row(free_to_dof_[i]) = cols.row(i);
 }
 
-void ImplicitSystem::Multiply(const VecX& v, VecX& out) const {
-  const int n = num_free_dofs();
-  for (int i = 0; i < n; ++i) rhs_free_[i] = v[free_to_dof_[i]];
-  product_free_.noalias() = A_ * rhs_free_;
-  out.setZero(v.size());
-  for (int i = 0; i < n; ++i) out[free_to_dof_[i]] = product_free_[i];
-}
+void ImplicitSystem::Multiply(const VecX& v, VecX& out) const { MultiplyWith(A_, v, out); }
 
 void ImplicitSystem::ResetNewtonMatrix() {
   if (!newton_analyzed_) {
@@ -163,33 +172,16 @@ void ImplicitSystem::AddNewtonBlock(int a, int b, const Mat3& block) {
 
 void ImplicitSystem::FactorNewtonMatrix(const std::string& body) {
   if (num_free_dofs() == 0) return;
-  const bool ok = use_cholmod_ ? newton_cholmod_.Factorize(H_)
-                               : newton_ldlt_.Factorize(H_) &&
-                                     newton_ldlt_.num_negative_pivots() == 0;
-  if (!ok)
+  if (!FactorWith(H_, newton_ldlt_, newton_cholmod_))
     throw SimulationError(internal::Concat("body '", body,
                                            "': Newton matrix A + sum rho J^T J is not positive "
                                            "definite (stage: primal constraint solve)"));
 }
 
 void ImplicitSystem::SolveNewton(Eigen::Ref<VecX> rhs) const {
-  const int n = num_free_dofs();
-  for (int i = 0; i < n; ++i) rhs_free_[i] = rhs[free_to_dof_[i]];
-  rhs.setZero();
-  if (n == 0) return;
-  if (use_cholmod_)
-    newton_cholmod_.Solve(rhs_free_);
-  else
-    newton_ldlt_.Solve(rhs_free_);
-  for (int i = 0; i < n; ++i) rhs[free_to_dof_[i]] = rhs_free_[i];
+  SolveWith(newton_ldlt_, newton_cholmod_, rhs);
 }
 
-void ImplicitSystem::MultiplyNewton(const VecX& v, VecX& out) const {
-  const int n = num_free_dofs();
-  for (int i = 0; i < n; ++i) rhs_free_[i] = v[free_to_dof_[i]];
-  product_free_.noalias() = H_ * rhs_free_;
-  out.setZero(v.size());
-  for (int i = 0; i < n; ++i) out[free_to_dof_[i]] = product_free_[i];
-}
+void ImplicitSystem::MultiplyNewton(const VecX& v, VecX& out) const { MultiplyWith(H_, v, out); }
 
 }  // namespace taut

@@ -2,17 +2,27 @@
 # Release build of taut_bench and a full benchmark run (5 repetitions, aggregates only), written to
 #   OUT_DIR/results.json   Google Benchmark's JSON (every aggregate and counter)
 #   OUT_DIR/summary.md     tables: taut vs Bullet's deformable world, tet-beam scaling with the
-#                          fitted growth exponent, point-vs-shape narrowphase time and accuracy
-# Usage: scripts/run_bench.sh [OUT_DIR] [-- extra taut_bench flags, e.g. --benchmark_filter=...]
-#   (default OUT_DIR docs/bench; build dir build/bench, or TAUT_BENCH_BUILD_DIR). The full run
-#   takes ~30 min on 2 cores, most of it in the 51k and 103k tet scaling sizes.
+#                          fitted growth exponent, point-vs-shape narrowphase time and accuracy,
+#                          island solvers (dual / primal / auto) against the unconstrained step
+# Usage: scripts/run_bench.sh [OUT_DIR] [--merge] [-- extra taut_bench flags, e.g.
+#   --benchmark_filter=...]   (default OUT_DIR docs/bench; build dir build/bench, or
+#   TAUT_BENCH_BUILD_DIR). The full run takes ~30 min on 2 cores, most of it in the 51k and 103k
+#   tet scaling sizes, plus the island solver cases (bench/island_solver_bench.cc).
+#   --merge: the benchmarks of this run replace those of the same name in OUT_DIR/results.json and
+#   the others are kept (a partial run, e.g. --benchmark_filter=BM_IslandSolver, updates its
+#   tables only). Every benchmark entry records the CPU model (lscpu), date and load of its run.
 set -euo pipefail
 # shellcheck source-path=SCRIPTDIR source=build.sh
 source "$(dirname "${BASH_SOURCE[0]}")/build.sh"
 
 out_dir="${TAUT_ROOT}/docs/bench"
-if (($# > 0)) && [[ "$1" != "--" ]]; then
+merge=0
+if (($# > 0)) && [[ "$1" != "--" && "$1" != "--merge" ]]; then
   out_dir="$1"
+  shift
+fi
+if (($# > 0)) && [[ "$1" == "--merge" ]]; then
+  merge=1
   shift
 fi
 if (($# > 0)) && [[ "$1" == "--" ]]; then
@@ -35,9 +45,33 @@ cmake -G Ninja -S . -B "${build_dir}" -DCMAKE_BUILD_TYPE=Release -DTAUT_BUILD_BE
 taut_stage "Building taut_bench (-j${TAUT_JOBS})"
 cmake --build "${build_dir}" -j"${TAUT_JOBS}" --target taut_bench
 
+# Benchmarks that set their own repetitions (the island solver cases: 3, or 1 for the
+# deterministic rest measurement) keep them; every other one runs 5.
 taut_stage "Running taut_bench (5 repetitions) into ${out_dir}/results.json"
 "${build_dir}/bench/taut_bench" --benchmark_repetitions=5 --benchmark_report_aggregates_only=true \
-  --benchmark_out="${out_dir}/results.json" --benchmark_out_format=json "$@"
+  --benchmark_out="${out_dir}/results.run.json" --benchmark_out_format=json "$@"
+
+taut_stage "Recording the machine$( ((merge)) && echo ", merging into ${out_dir}/results.json")"
+cpu_model="$(lscpu 2>/dev/null | sed -n 's/^Model name:[[:space:]]*//p' | head -n 1)"
+python3 - "${out_dir}/results.run.json" "${out_dir}/results.json" "${merge}" "${cpu_model}" <<'PY'
+import json, os, sys
+
+run = json.load(open(sys.argv[1]))
+ctx = run["context"]
+ctx["cpu_model"] = sys.argv[4] or "unknown"
+for b in run["benchmarks"]:
+    b["run_date"] = ctx.get("date")
+    b["run_cpu_model"] = ctx["cpu_model"]
+    b["run_load_avg"] = ctx.get("load_avg", [])
+if sys.argv[3] == "1" and os.path.exists(sys.argv[2]):
+    old = json.load(open(sys.argv[2]))
+    names = {b.get("run_name", b["name"]) for b in run["benchmarks"]}
+    kept = [b for b in old["benchmarks"] if b.get("run_name", b["name"]) not in names]
+    run["benchmarks"] = kept + run["benchmarks"]
+    run["context"] = old["context"]
+json.dump(run, open(sys.argv[2], "w"), indent=2)
+PY
+rm -f "${out_dir}/results.run.json"
 
 taut_stage "Writing ${out_dir}/summary.md"
 python3 - "${out_dir}/results.json" "${out_dir}/summary.md" <<'PY'
@@ -45,15 +79,20 @@ import json, math, re, sys
 
 data = json.load(open(sys.argv[1]))
 median = {}
+single = {}
 errors = {}
 for b in data["benchmarks"]:
     # "BM_X/10/min_time:0.500/repeats:5/manual_time" -> "BM_X/10"
     name = b.get("run_name", b["name"])
-    name = re.sub(r"/(repeats|min_time|manual_time|real_time)[^/]*", "", name)
+    name = re.sub(r"/(repeats|min_time|manual_time|real_time|iterations)[^/]*", "", name)
     if b.get("error_occurred"):
         errors[name] = b.get("error_message", "error")
     elif b.get("aggregate_name") == "median":
         median[name] = b
+    elif b.get("run_type") == "iteration":
+        single.setdefault(name, b)  # one repetition only (no aggregates): its own figures
+for name, b in single.items():
+    median.setdefault(name, b)
 
 def rows(prefix):
     return [(n, b) for n, b in median.items() if n.startswith(prefix)]
@@ -67,11 +106,13 @@ out = ["# Benchmark results", "",
        f"load average {', '.join(fmt(x, 2) for x in ctx.get('load_avg', []))} at the start; "
        f"{ctx.get('date')}. Medians of 5 repetitions. Produced by `scripts/run_bench.sh`.", ""]
 
-out += ["## taut DeformableWorld vs Bullet 3.24 btDeformableMultiBodyDynamicsWorld", "",
-        "Per-step thread CPU time, same mesh, masses, material and h = 1/240 s "
-        "(bench/bullet_deformable_bench.cc).", "",
-        "| scene | tets | taut ms/step | Bullet ms/step | taut / Bullet | sanity |",
-        "|---|---:|---:|---:|---:|---|"]
+versus = rows("BM_BeamTautVsBullet") + rows("BM_BallDropTautVsBullet")
+if versus:
+    out += ["## taut DeformableWorld vs Bullet 3.24 btDeformableMultiBodyDynamicsWorld", "",
+            "Per-step thread CPU time, same mesh, masses, material and h = 1/240 s "
+            "(bench/bullet_deformable_bench.cc).", "",
+            "| scene | tets | taut ms/step | Bullet ms/step | taut / Bullet | sanity |",
+            "|---|---:|---:|---:|---:|---|"]
 for name, b in rows("BM_BeamTautVsBullet") + rows("BM_BallDropTautVsBullet"):
     if "Beam" in name:
         sanity = (f"tip z: taut {fmt(b['taut_tip_z_m'])} m, Bullet {fmt(b['bullet_tip_z_m'])} m, "
@@ -140,8 +181,108 @@ if methods:
                          f"no gap {int(b['no_answer'])}")
         out.append(f"| {m} | " + " | ".join(cells) + " |")
 
+island = rows("BM_IslandSolver/")
+if island:
+    # "BM_IslandSolver/<case>[/<size>]/<path>": path none is the case's unconstrained twin.
+    def split(name):
+        parts = name.split("/")[1:]
+        return "/".join(parts[:-1]), parts[-1]
+    twin = {split(n)[0]: b for n, b in island if split(n)[1] == "none"}
+    first = island[0][1]
+    targets = {"tet_iso": "<= 3x", "tet_aniso": "<= 3x", "hex_0.1J": "<= 2x, <= 4 SQP",
+               "slab_rest": "<= 3x", "slab_roll": "<= 3x", "rest_box": "< 0.1 mm"}
+    loads = ", ".join(fmt(x, 2) for x in first.get("run_load_avg", []))
+    dates = sorted({b.get("run_date") or ctx.get("date") for _, b in island})
+    when = dates[0] if len(dates) == 1 else f"runs started {', '.join(dates)}"
+    out += ["", "## Island solvers: constrained step vs the unconstrained step", "",
+            f"CPU: {first.get('run_cpu_model', 'unknown')} ({ctx.get('num_cpus')} cores), "
+            f"{when}, load average {loads} at the start of the first run. Other work shares "
+            "the machine, so compare ratios within a case (its paths and its twin run back to "
+            "back). bench/island_solver_bench.cc, one Release binary; each case is warmed up outside "
+            "the timed loop (beams swing into their limits, slabs settle, the sphere starts "
+            "rolling), then only `stepSimulation` is timed. Medians of 3 repetitions (rest_box: "
+            "1, deterministic) of per-repetition medians over the timed steps.", "",
+            "- ms/step: thread CPU time per step. twin: the same body stepped without limits, "
+            "ground or rigid body (no rows: its unconstrained step alone), in the same run; "
+            "ratio = ms/step over the twin's.",
+            "- in-step ratio: sum of `ms_total` over sum of `ms_unconstrained` of the same steps "
+            "(StepStats, steady clock; the `steps.csv` ratio of issue 11).",
+            "- SQP / Newton: mean iterations per step; unconverged: steps with "
+            "`StepStats::converged` false, of the timed steps; max viol.: max `violation_after` "
+            "(C units); primal: share of islands the primal path solved.",
+            "- slab_roll sanity: sphere dx is the distance it rolled in the timed steps of one "
+            "repetition, z its centre height at the end (0.18 m on the undeformed slab).", "",
+            "| case | elements | path | ms/step | twin ms/step | ratio | in-step ratio | "
+            "SQP | Newton | PGS sweeps | rows | unconverged | max viol. | primal | target |",
+            "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|"]
+    order = {"none": 0, "dual": 1, "primal": 2, "auto": 3}
+    cases = ["tet_iso", "tet_aniso", "hex_0.1J", "slab_rest", "slab_roll", "rest_box"]
+    def case_key(nb):
+        case, path = split(nb[0])
+        base, _, size = case.partition("/")
+        rank = cases.index(base) if base in cases else len(cases)
+        return (rank, base, int(size) if size else 0, order.get(path, 9))
+    island.sort(key=case_key)
+    for name, b in island:
+        case, path = split(name)
+        if path == "none":
+            continue
+        t = twin.get(case)
+        ratio = fmt(b["ms_step"] / t["ms_step"]) if t and t["ms_step"] > 0 else "-"
+        extra = ""
+        if "height_change_mm" in b:
+            extra = f"; height change {fmt(b['height_change_mm'], 2)} mm"
+        if "rigid_dx_m" in b:
+            extra = (f"; sphere dx {fmt(b['rigid_dx_m'], 2)} m, z {fmt(b['rigid_z_m'], 3)} m")
+        out.append(f"| {case} | {int(b['elements'])} | {path} | {fmt(b['ms_step'])} | "
+                   f"{fmt(t['ms_step']) if t else '-'} | {ratio} | {fmt(b['in_step_ratio'])} | "
+                   f"{b['sqp_mean']:.2f} | {b['newton_mean']:.2f} | {b['pgs_sweeps_mean']:.0f} | "
+                   f"{b['rows_mean']:.0f} | {int(b['unconverged'])}/{int(b['steps'])} | "
+                   f"{fmt(b['max_violation'], 2)} | {b['primal_share']:.2f} | "
+                   f"{targets.get(case.split('/')[0], '')}{extra} |")
+    rest = [(n, b) for n, b in island if "height_change_mm" in b]
+    if rest:
+        out += ["", "Rest is rest (rest_box: 1 kg rigid 0.1 m box on a 0.2 m soft block, E = 20 "
+                "kPa, limits 0.96..1.04, on the ground): box height change over the last second "
+                "of a 2 s rest (target < 0.1 mm), and the largest excursion in that second.", "",
+                "| path | height change [mm] | max excursion [mm] | pass |", "|---|---:|---:|---|"]
+        for n, b in rest:
+            out.append(f"| {split(n)[1]} | {fmt(b['height_change_mm'], 3)} | "
+                       f"{fmt(b['max_drift_mm'], 3)} | "
+                       f"{'yes' if b['height_change_mm'] < 0.1 else 'no'} |")
+    grow = {}
+    for name, b in island:
+        case, path = split(name)
+        base, _, size = case.partition("/")
+        if size:
+            grow.setdefault(base, {}).setdefault(path, []).append(
+                (math.log(b["elements"]), math.log(b["ms_step"]), math.log(b["ms_unc"])))
+    if grow:
+        out += ["", "Growth of the cost per step under mesh refinement: least-squares exponent p "
+                "of ms/step ~ elements^p (twin: the unconstrained twin; stage 2: "
+                "`ms_unconstrained` of the constrained steps themselves).", "",
+                "| case | sizes (elements) | path | p (step) | p (stage 2 of the same steps) | "
+                "p (twin) |", "|---|---|---|---:|---:|---:|"]
+        def fit(pts):
+            n = len(pts)
+            mx = sum(x for x, _ in pts) / n
+            my = sum(y for _, y in pts) / n
+            den = sum((x - mx) ** 2 for x, _ in pts)
+            return sum((x - mx) * (y - my) for x, y in pts) / den if den > 0 else float("nan")
+        for base, paths in grow.items():
+            t = paths.get("none", [])
+            p_twin = fit([(x, y) for x, y, _ in t]) if len(t) >= 2 else float("nan")
+            for path in ("dual", "primal", "auto"):
+                pts = paths.get(path, [])
+                if len(pts) < 2:
+                    continue
+                sizes = ", ".join(str(round(math.exp(x))) for x, _, _ in sorted(pts))
+                out.append(f"| {base} | {sizes} | {path} | {fit([(x, y) for x, y, _ in pts]):.2f} | "
+                           f"{fit([(x, u) for x, _, u in pts]):.2f} | {p_twin:.2f} |")
+
 other = [n for n in median if not n.startswith(("BM_BeamTautVsBullet", "BM_BallDropTautVsBullet",
-                                                 "BM_TetBeamScaling", "BM_PointDistance/"))]
+                                                 "BM_TetBeamScaling", "BM_PointDistance/",
+                                                 "BM_IslandSolver/"))]
 if other:
     out += ["", "## Other benchmarks", "", "| benchmark | time (wall) | time (CPU) |",
             "|---|---:|---:|"]

@@ -15,6 +15,7 @@ ReportRow MakeRow(const std::string& family, const std::string& label, double ms
   ReportRow row;
   row.family = family;
   row.label = label;
+  row.solver = "dual";
   row.cpu_ms_frame_mean = ms;
   row.max_violation = violation;
   row.traj_error_rms = 0.1 / ms;
@@ -35,6 +36,12 @@ TEST(ReportPlotScriptTest, SelectsPanelsWithPositiveValues) {
   ReportRow reference = MakeRow("reference", "dt/8", 100.0, 1e-3);
   reference.max_stationarity = 0.5;
   rows.push_back(reference);
+  ReportRow failed = MakeRow("newton", "1", 5.0, 3.0);
+  failed.max_kkt_complementarity = 2.0;
+  failed.status = "failed at t = 0.05 s: body 'beam': node 67 moves at 1e+06 m/s";
+  rows.push_back(failed);  // a failed run is not drawn, so it adds no panel
+  EXPECT_FALSE(IsPlotted(failed));
+  EXPECT_FALSE(IsPlotted(reference));
   rows[0].max_energy_ratio = 0.97;  // below the limit: nothing to plot
   std::vector<PlotPanel> panels = SelectPanels(rows);
   ASSERT_EQ(panels.size(), 1u);
@@ -51,14 +58,15 @@ TEST(ReportPlotScriptTest, SelectsPanelsWithPositiveValues) {
   EXPECT_TRUE(SelectPanels(rows).empty());
 }
 
-// The script draws every panel with one line and one label set per family, from the right CSV
-// columns, log-log, into the requested PNG; nothing to draw throws.
-TEST(ReportPlotScriptTest, ScriptHasOneLinePerFamilyAndPanel) {
+// The script draws every panel with one line and one label set per (family, solver) curve, from
+// the right CSV columns, log-log, into the requested PNG, the legend in the first panel only;
+// nothing to draw throws.
+TEST(ReportPlotScriptTest, ScriptHasOneLinePerCurveAndPanel) {
   PlotRequest request;
   request.csv_path = "it's.csv";
   request.png_path = "scene.png";
   request.title = "scene";
-  request.families = {"pgs", "sqp", "dt"};
+  request.curves = {{"pgs", "dual"}, {"sqp", "dual"}, {"dt", "primal"}};
   request.panels = {{"max_violation", 0.0, "violation"},
                     {"max_energy_ratio", 1.0, "U - 1"},
                     {"traj_error_rms", 0.0, "error"}};
@@ -70,10 +78,23 @@ TEST(ReportPlotScriptTest, ScriptHasOneLinePerFamilyAndPanel) {
   EXPECT_EQ(Count(script, "\nplot "), 3);
   EXPECT_EQ(Count(script, "with linespoints"), 9);
   EXPECT_EQ(Count(script, "with labels"), 9);
-  EXPECT_EQ(Count(script, "title 'SQP iteration cap'"), 3);
+  EXPECT_EQ(Count(script, "title 'SQP iteration cap, dual'"), 3);
+  EXPECT_EQ(Count(script, "title 'time step, primal'"), 3);
+  EXPECT_EQ(Count(script, "unset key"), 1);
   const std::string x = "$" + std::to_string(FindCsvColumn("cpu_ms_frame_mean"));
   const std::string y = "$" + std::to_string(FindCsvColumn("max_energy_ratio"));
-  EXPECT_NE(script.find("eq 'dt' ? " + x + " : NaN"), std::string::npos);
+  const std::string solver = std::to_string(FindCsvColumn("solver"));
+  const std::string status = std::to_string(FindCsvColumn("status"));
+  EXPECT_NE(script.find("eq 'dt' && strcol(" + solver + ") eq 'primal' && strstrt(strcol(" +
+                        status + "), 'failed') != 1 ? " + x + " : NaN"),
+            std::string::npos);
+  // Same family on both paths: same colour, other dash type.
+  request.curves = {{"sqp", "dual"}, {"sqp", "primal"}, {"default", "auto"}};
+  const std::string two = MakeGnuplotScript(request);
+  EXPECT_EQ(Count(two, "dt 1 pt 7 lc " + FamilyColor("sqp")), 3);
+  EXPECT_EQ(Count(two, "dt 2 pt 5 lc " + FamilyColor("sqp")), 3);
+  EXPECT_EQ(Count(two, "with points"), 3);  // the default-settings point is not joined
+  EXPECT_NE(FamilyColor("sqp"), FamilyColor("tol"));
   EXPECT_NE(script.find("(" + y + " - 1) > 0"), std::string::npos);
   request.panels.clear();
   EXPECT_THROW(MakeGnuplotScript(request), InputError);
@@ -85,9 +106,13 @@ TEST(ReportPlotScriptTest, GnuplotDrawsThePng) {
   const std::string dir = ::testing::TempDir() + "/report_plot_script_test";
   std::filesystem::create_directories(dir);
   std::filesystem::remove(dir + "/scene.png");
-  const std::vector<ReportRow> rows = {MakeRow("pgs", "5", 10.0, 1e-2),
-                                       MakeRow("pgs", "50", 30.0, 1e-3),
-                                       MakeRow("dt", "dt/2", 20.0, ReportRow::kNaN)};
+  std::vector<ReportRow> rows = {MakeRow("pgs", "5", 10.0, 1e-2), MakeRow("pgs", "50", 30.0, 1e-3),
+                                 MakeRow("dt", "dt/2", 20.0, ReportRow::kNaN),
+                                 MakeRow("dt", "dt/2", 25.0, 2e-3)};
+  rows.back().solver = "primal";
+  rows.push_back(MakeRow("dt", "dt", 5.0, 1.0));
+  rows.back().solver = "primal";
+  rows.back().status = "failed at t = 0.1 s: node 3, stage integrate";
   std::ofstream csv(dir + "/scene.csv");
   csv << FormatCsvHeader() << "\n";
   for (const ReportRow& row : rows) csv << FormatCsvRow(row) << "\n";
@@ -96,7 +121,7 @@ TEST(ReportPlotScriptTest, GnuplotDrawsThePng) {
   request.csv_path = "scene.csv";
   request.png_path = "scene.png";
   request.title = "scene";
-  request.families = {"pgs", "dt"};
+  request.curves = {{"pgs", "dual"}, {"dt", "dual"}, {"dt", "primal"}};
   request.panels = SelectPanels(rows);
   std::ofstream(dir + "/scene.gp") << MakeGnuplotScript(request);
   ASSERT_EQ(std::system(("cd '" + dir + "' && gnuplot scene.gp 2> gnuplot.log").c_str()), 0);

@@ -34,13 +34,13 @@ bool HasGnuplot() { return std::system("command -v gnuplot > /dev/null 2>&1") ==
 
 PlotFiles WriteReportPlot(const std::string& dir, const std::string& name,
                           const std::vector<ReportRow>& rows,
-                          const std::vector<std::string>& families) {
+                          const std::vector<SweepCurve>& curves) {
   PlotFiles files;
   PlotRequest request;
   request.csv_path = name + ".csv";
   request.png_path = name + ".png";
   request.title = name + ": error against CPU time per simulated frame (log-log)";
-  request.families = families;
+  request.curves = curves;
   request.panels = SelectPanels(rows, request.x_column);
   if (request.panels.empty()) {
     files.note = "No plot: no error is positive in any run.";

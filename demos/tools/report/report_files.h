@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "demos/tools/report/report_table.h"
+#include "demos/tools/report/sweep_plan.h"
 
 namespace taut {
 
@@ -21,7 +22,7 @@ struct PlotFiles {
 // <dir>/<name>.png. Without gnuplot, or with nothing plottable, says so in the note instead.
 PlotFiles WriteReportPlot(const std::string& dir, const std::string& name,
                           const std::vector<ReportRow>& rows,
-                          const std::vector<std::string>& families);
+                          const std::vector<SweepCurve>& curves);
 
 // Writes text to path; throws InputError when it cannot.
 void WriteTextFile(const std::string& path, const std::string& text);

@@ -17,9 +17,11 @@ namespace {
 void LogRun(const std::string& scene, const ReportRow& row) {
   std::fprintf(
       stderr,
-      "  %-15s %-9s %-7s %9.3f CPU ms/frame  viol %-9.3g stat %-9.3g err %-9.3g %7.1f s  %s\n",
-      scene.c_str(), row.family.c_str(), row.label.c_str(), row.cpu_ms_frame_mean,
-      row.max_violation, row.max_stationarity, row.traj_error_rms, row.wall_s, row.status.c_str());
+      "  %-15s %-9s %-7s %-6s %9.3f CPU ms/frame  unconv %-4d viol %-9.3g stat %-9.3g err %-9.3g "
+      "%7.1f s  %s\n",
+      scene.c_str(), row.family.c_str(), row.label.c_str(), row.solver.c_str(),
+      row.cpu_ms_frame_mean, row.unconverged_steps, row.max_violation, row.max_stationarity,
+      row.traj_error_rms, row.wall_s, row.status.c_str());
 }
 
 // Path of `path` relative to folder `base` (both as given, made absolute first).
@@ -60,7 +62,7 @@ SceneSection MeasureScene(const SceneInfo& info, const SceneReportOptions& optio
   // Reference first: where it gets within its budget sets the simulated time of every run.
   const int divisor = options.lists.reference_divisor;
   const SweepPoint reference_point{"reference", "dt/" + std::to_string(divisor), divisor,
-                                   MakeReferenceSettings(base)};
+                                   MakeReferenceSettings(base, options.lists.reference_solver)};
   plan.cpu_budget_s = options.reference_budget_s;
   RunOutcome reference_run = RunSweepPoint(info, reference_point, plan, nullptr);
   LogRun(info.name, reference_run.row);
@@ -76,8 +78,11 @@ SceneSection MeasureScene(const SceneInfo& info, const SceneReportOptions& optio
   plan.samples = reference_run.completed_samples;
   section.duration_s = plan.samples * plan.frame_steps * plan.dt;
   char text[256];
-  std::snprintf(text, sizeof(text), "dt/%d with tight settings, %.1f s wall%s", divisor,
-                reference_run.row.wall_s, cut.c_str());
+  std::snprintf(text, sizeof(text),
+                "dt/%d with tight settings on the %s path, %d of %d steps uncertified, %.1f s "
+                "wall%s",
+                divisor, reference_run.row.solver.c_str(), reference_run.row.unconverged_steps,
+                reference_run.row.steps, reference_run.row.wall_s, cut.c_str());
   section.reference = text;
   ReferenceTrajectory reference{reference_run.samples, reference_run.lengths};
   reference.samples.resize(plan.samples);
@@ -107,7 +112,7 @@ SceneSection MeasureScene(const SceneInfo& info, const SceneReportOptions& optio
   WriteReportCsv(csv, section.rows);
   section.csv_link = RelativeTo(csv, options.page_dir);
   const PlotFiles plot =
-      WriteReportPlot(options.out_dir, info.name, section.rows, ListFamilies(points));
+      WriteReportPlot(options.out_dir, info.name, section.rows, ListCurves(points));
   if (!plot.png.empty()) section.png_link = RelativeTo(plot.png, options.page_dir);
   section.plot_note = plot.note;
   return section;

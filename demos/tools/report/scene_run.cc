@@ -74,8 +74,10 @@ TrajectorySample SampleFreeNodes(const Scene& scene) {
 // Running sums of the per-step statistics.
 struct StepTally {
   int steps = 0, unconverged = 0, constrained_steps = 0;
-  double sqp = 0.0, sweeps = 0.0, stationarity_sum = 0.0;
+  double sqp = 0.0, sweeps = 0.0, newton = 0.0, pcg = 0.0, stationarity_sum = 0.0;
+  double islands_dual = 0.0, islands_primal = 0.0;
   double max_violation = 0.0, max_stationarity = 0.0;
+  double max_kkt_primal = 0.0, max_kkt_complementarity = 0.0, max_kkt_dual = 0.0;
   double max_lcp = ReportRow::kNaN, max_penetration = ReportRow::kNaN;
   bool any_contact = false;
 
@@ -85,12 +87,20 @@ struct StepTally {
     unconverged += s.converged ? 0 : 1;
     sqp += s.sqp_iterations;
     sweeps += s.pgs_sweeps;
+    newton += s.newton_iterations;
+    pcg += s.pcg_iterations;
+    islands_dual += s.islands_dual;
+    islands_primal += s.islands_primal;
     max_violation = std::max(max_violation, s.violation_after);
     if (s.rows_total() > 0) {
       ++constrained_steps;
       stationarity_sum += s.stationarity;
       max_stationarity = std::max(max_stationarity, s.stationarity);
-      max_lcp = MaxOfKnown(max_lcp, ReadLcpResidual(s));
+      max_kkt_primal = std::max(max_kkt_primal, s.kkt_primal);
+      max_kkt_complementarity = std::max(max_kkt_complementarity, s.kkt_complementarity);
+      max_kkt_dual = std::max(max_kkt_dual, s.kkt_dual);
+      // The natural-map residual is the dual path's (its last QP); the primal path has no QP.
+      if (s.islands_dual > 0) max_lcp = MaxOfKnown(max_lcp, ReadLcpResidual(s));
     }
     if (s.rows_contact > 0) any_contact = true;
     max_penetration = MaxOfKnown(max_penetration, ReadMaxPenetration(s));
@@ -124,9 +134,13 @@ RunOutcome RunSweepPoint(const SceneInfo& info, const SweepPoint& point, const R
   ReportRow& row = out.row;
   row.family = point.family;
   row.label = point.label;
+  row.solver = GetIslandSolverName(point.settings.solver);
   row.dt = h;
   row.pgs_max_sweeps = point.settings.pgs.max_sweeps;
   row.sqp_max_iterations = point.settings.max_iterations;
+  row.primal_max_iterations = point.settings.primal.max_iterations;
+  row.newton_max_iterations = point.settings.primal.max_newton_iterations;
+  row.penalty_scale = point.settings.primal.penalty_scale;
   row.violation_tolerance = point.settings.violation_tolerance;
   row.stationarity_tolerance = point.settings.stationarity_tolerance;
   StepTally tally;
@@ -186,13 +200,22 @@ RunOutcome RunSweepPoint(const SceneInfo& info, const SweepPoint& point, const R
     row.cpu_ms_frame_mean = cpu_ms_total / (tally.steps * h) * (1.0 / 60.0);
     row.mean_sqp_iterations = tally.sqp / tally.steps;
     row.mean_pgs_sweeps = tally.sweeps / tally.steps;
+    row.mean_newton_iterations = tally.newton / tally.steps;
+    row.mean_pcg_iterations = tally.pcg / tally.steps;
   }
+  if (tally.islands_dual + tally.islands_primal > 0)
+    row.primal_island_share = tally.islands_primal / (tally.islands_dual + tally.islands_primal);
   row.unconverged_steps = tally.unconverged;
   row.max_violation = tally.max_violation;
   row.max_stationarity = tally.max_stationarity;
   row.mean_stationarity =
       tally.constrained_steps > 0 ? tally.stationarity_sum / tally.constrained_steps : 0.0;
   row.max_lcp_residual = tally.max_lcp;
+  if (tally.constrained_steps > 0) {
+    row.max_kkt_primal = tally.max_kkt_primal;
+    row.max_kkt_complementarity = tally.max_kkt_complementarity;
+    row.max_kkt_dual = tally.max_kkt_dual;
+  }
   // Energy ratio and penetration: the scene's own run maxima, and the step statistics' depth.
   nlohmann::json figures;
   scene->WriteFigures(figures);
