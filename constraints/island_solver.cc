@@ -35,8 +35,12 @@ void IslandSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     std::swap(dual_.mutable_warm_starts(), warm_);
     dual_.Solve(h, bodies, sources, settings, stats);
     std::swap(dual_.mutable_warm_starts(), warm_);
-    // Measured failure: the next steps go to the primal path (kAuto only).
-    if (!stats.converged && settings.solver == IslandSolverKind::kAuto)
+    // Measured failure of a limit-only island: the next steps go to the primal path (kAuto
+    // only). Islands with contact or joint rows stay dual: there the primal path failed more
+    // steps than the dual (finger: 46 vs 23 of 493, docs/report.md).
+    const bool limit_rows_only =
+        stats.rows_contact + stats.rows_rigid_contact + stats.rows_joint == 0;
+    if (!stats.converged && limit_rows_only && settings.solver == IslandSolverKind::kAuto)
       primal_steps_left_ = kPrimalStepsAfterDualFailure;
   }
   last_rows_ = stats.rows_total();

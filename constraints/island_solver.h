@@ -21,7 +21,8 @@ class IslandSolver {
   void Solve(double h, const std::vector<IslandBody*>& bodies,
              const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
              StepStats& stats);
-  // Steps the primal path keeps an island after the dual path failed its certificate there.
+  // Steps the primal path keeps a limit-only island after the dual path failed its certificate
+  // there.
   static constexpr int kPrimalStepsAfterDualFailure = 20;
 
   // The path kAuto takes for an island with `rows` rows (last step) on `free_dofs` free DOFs,
