@@ -122,7 +122,8 @@ void PrimalSolver::LinearizeRows(double h, const std::vector<IslandBody*>& bodie
 void PrimalSolver::CollectCurvature(double h, const std::vector<IslandBody*>& bodies,
                                     const std::vector<ConstraintSource*>& sources) {
   curvature_.clear();
-  VecX weights = VecX::Zero(rows_.size());
+  VecX& weights = curvature_weights_;  // reused across iterations
+  weights.setZero(rows_.size());
   bool any = false;
   for (int c = 0; c < rows_.size(); ++c) {
     if (!IsLimitRow(rows_[c]) || lambda_[c] <= 0.0) continue;

@@ -97,6 +97,7 @@ class PrimalSolver {
     Mat3 block;
   };
   std::vector<CurvatureBlock> curvature_;
+  VecX curvature_weights_;  // h lambda_c of the rows, for the sources' curvature
   // Consecutive rows on the same nodes of one body (one element's rows): their summed
   // rho D J^T J as one dense block, scattered into the Newton matrix once.
   struct RowGroup {
