@@ -4,12 +4,23 @@
 
 namespace taut {
 
+TetRestStiffness CalcTetRestStiffness(const TetRestElement& rest, const LameParameters& lame) {
+  TetRestStiffness K0;
+  for (int n = 0; n < 4; ++n)
+    for (int m = 0; m < 4; ++m) K0[4 * n + m] = CalcRestStiffnessBlock(rest, lame, n, m);
+  return K0;
+}
+
 TetElementModel::TetElementModel(std::shared_ptr<const TetMesh> mesh, const Material& material)
     : mesh_(std::move(mesh)) {
   TAUT_DEMAND(mesh_ != nullptr, "TetElementModel: mesh is null");
   material.Validate(mesh_->source);
   rest_ = CalcTetRestData(*mesh_);
   lame_ = {material.mu(), material.lambda()};
+  // K0 depends only on the rest shape and the material, both fixed from here on.
+  rest_stiffness_.reserve(num_elements());
+  for (const TetRestElement& rest : rest_.elements)
+    rest_stiffness_.push_back(CalcTetRestStiffness(rest, lame_));
   rest_positions_.resize(3 * num_nodes());
   for (int i = 0; i < num_nodes(); ++i) rest_positions_.segment<3>(3 * i) = mesh_->nodes[i];
   rotations_.assign(num_elements(), Mat3::Identity());
@@ -48,12 +59,12 @@ void TetElementModel::AddScaledStiffness(double scale, const std::vector<int>& i
                                          double* values) const {
   for (int e = 0; e < num_elements(); ++e) {
     const Mat3& R = rotations_[e];
+    const TetRestStiffness& K0 = rest_stiffness_[e];
     const int* map = index_map.data() + 144 * e;
     for (int a = 0; a < 4; ++a) {
       for (int b = 0; b < 4; ++b, map += 9) {
         // Block (a,b) of R K0 R^T, entries column-major.
-        const Mat3 K = scale * (R * CalcRestStiffnessBlock(rest_.elements[e], lame_, a, b) *
-                                R.transpose());
+        const Mat3 K = scale * (R * K0[4 * a + b] * R.transpose());
         for (int k = 0; k < 9; ++k)
           if (map[k] >= 0) values[map[k]] += K.data()[k];
       }
@@ -64,12 +75,12 @@ void TetElementModel::AddScaledStiffness(double scale, const std::vector<int>& i
 void TetElementModel::AddScaledStiffnessTimes(double scale, const VecX& v, VecX& out) const {
   for (int e = 0; e < num_elements(); ++e) {
     const Mat3& R = rotations_[e];
+    const TetRestStiffness& K0 = rest_stiffness_[e];
     const auto& t = mesh_->tets[e];
     for (int a = 0; a < 4; ++a) {
+      // out_a += scale R sum_b K0_ab R^T v_b.
       Vec3 sum = Vec3::Zero();
-      for (int b = 0; b < 4; ++b)
-        sum += CalcRestStiffnessBlock(rest_.elements[e], lame_, a, b) *
-               (R.transpose() * v.segment<3>(3 * t[b]));
+      for (int b = 0; b < 4; ++b) sum += K0[4 * a + b] * (R.transpose() * v.segment<3>(3 * t[b]));
       out.segment<3>(3 * t[a]) += scale * (R * sum);
     }
   }

@@ -1,7 +1,9 @@
 // Co-rotational linear tets of one body (corotated_tet_element.h kernels over a TetMesh).
 #pragma once
 
+#include <array>
 #include <memory>
+#include <vector>
 
 #include "plugin/corotated_tet_element.h"
 #include "plugin/element_model.h"
@@ -9,8 +11,15 @@
 
 namespace taut {
 
-// ElementModel for a tet mesh with one material. Rest data is shared and immutable; the
-// per-element rotations are the runtime state.
+// Rest stiffness K0 of one tet as its 16 3x3 blocks, block (n,m) = CalcRestStiffnessBlock(n, m)
+// at index 4 n + m (1152 bytes) [N/m].
+using TetRestStiffness = std::array<Mat3, 16>;
+
+// The 16 blocks K0_nm of one tet, each exactly as CalcRestStiffnessBlock computes it.
+TetRestStiffness CalcTetRestStiffness(const TetRestElement& rest, const LameParameters& lame);
+
+// ElementModel for a tet mesh with one material. Rest data (r_n, volumes, K0) is computed once at
+// construction and immutable; the per-element rotations are the runtime state.
 class TetElementModel final : public ElementModel {
  public:
   // Validates the mesh and the material (throws InputError naming mesh.source).
@@ -31,6 +40,10 @@ class TetElementModel final : public ElementModel {
   const TetMesh& mesh() const { return *mesh_; }
   const TetRestData& rest() const { return rest_; }
   const LameParameters& lame() const { return lame_; }
+  // Stored rest stiffness block K0_ab of element e (CalcRestStiffnessBlock at construction).
+  const Mat3& rest_stiffness_block(int e, int a, int b) const {
+    return rest_stiffness_[e][4 * a + b];
+  }
   // Rotation of element e from the last UpdateRotationsAndAddForces.
   const Mat3& rotation(int e) const { return rotations_[e]; }
   // Node positions of element e gathered from x.
@@ -41,7 +54,8 @@ class TetElementModel final : public ElementModel {
   TetRestData rest_;
   LameParameters lame_;
   VecX rest_positions_;
-  std::vector<Mat3> rotations_;  // (num_tets)
+  std::vector<TetRestStiffness> rest_stiffness_;  // (num_tets), from rest_ and lame_
+  std::vector<Mat3> rotations_;                   // (num_tets)
 };
 
 }  // namespace taut

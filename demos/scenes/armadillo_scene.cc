@@ -34,7 +34,8 @@ std::vector<ArmadilloScene::Material> ArmadilloScene::DefaultMaterials() {
           {"limited_500kPa_100J", 500e3, 100.0}};
 }
 
-ArmadilloScene::ArmadilloScene(const std::vector<Material>& materials, const std::string& off_path) {
+ArmadilloScene::ArmadilloScene(const std::vector<Material>& materials,
+                               const std::string& off_path) {
   const std::string path =
       off_path.empty() ? std::string(TAUT_SOURCE_DIR) + "/data/armadillo.off" : off_path;
   TAUT_DEMAND(std::filesystem::exists(path), "armadillo scene: ", path,
@@ -58,10 +59,10 @@ ArmadilloScene::ArmadilloScene(const std::vector<Material>& materials, const std
         MakeSceneBodySettings(materials[m].name, materials[m].youngs_modulus, 500.0);
     settings.contact_margin = 0.05;
     DeformableBody* body = world().AddHexBody(lattice, settings);
-    limits_.push_back(materials[m].u_max ? world().SetEnergyLimits(
-                                               body, EnergyLimitSettings::PerElementEnergy(
-                                                         *materials[m].u_max))
-                                         : nullptr);
+    limits_.push_back(materials[m].u_max
+                          ? world().SetEnergyLimits(
+                                body, EnergyLimitSettings::PerElementEnergy(*materials[m].u_max))
+                          : nullptr);
     AttachEmbeddedSurface(static_cast<int>(m), placed);
     double lo, hi;
     CalcZRange(*body, lo, hi);
@@ -72,9 +73,7 @@ ArmadilloScene::ArmadilloScene(const std::vector<Material>& materials, const std
   max_ratio_.assign(materials.size(), 0.0);
 }
 
-
-void ArmadilloScene::Step(double dt) {
-  Scene::Step(dt);
+void ArmadilloScene::Measure(double /*dt*/) {
   for (size_t m = 0; m < max_flattening_.size(); ++m) {
     const DeformableBody& body = world().deformable_body(static_cast<int>(m));
     double lo, hi;

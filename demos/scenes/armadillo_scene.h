@@ -23,7 +23,8 @@ class ArmadilloScene : public Scene {
   explicit ArmadilloScene(const std::vector<Material>& materials, const std::string& off_path = "");
   static std::vector<Material> DefaultMaterials();
 
-  void Step(double dt) override;
+  // Updates the run's lowest point and largest flattening and energy ratio.
+  void Measure(double dt) override;
   void WriteFigures(nlohmann::json& figures) const override;
   // Pictures: start, impact (largest flattening) and rest (the end).
   std::vector<KeyFrame> CollectKeyFrames(int step, int num_steps) override;

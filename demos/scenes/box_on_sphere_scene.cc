@@ -30,9 +30,9 @@ BoxOnSphereScene::BoxOnSphereScene(double youngs_modulus, double u_max) {
   for (int i = 0; i < sphere->num_nodes(); ++i) top = std::max(top, sphere->node_position(i).z());
   double z = top + 0.002;
   for (int k = 0; k < 3; ++k) {
-    boxes_.push_back(holder_.AddRigidBody(
-        std::make_unique<btBoxShape>(btVector3(kHalf[k], kHalf[k], kHalf[k])), kMass[k],
-        btVector3(0, 0, z + kHalf[k]), 0.8));
+    boxes_.push_back(
+        holder_.AddRigidBody(std::make_unique<btBoxShape>(btVector3(kHalf[k], kHalf[k], kHalf[k])),
+                             kMass[k], btVector3(0, 0, z + kHalf[k]), 0.8));
     z += 2.0 * kHalf[k] + 0.002;
   }
 }
@@ -54,8 +54,7 @@ double BoxOnSphereScene::CalcFlattening() const {
   return 1.0 - (hi - lo) / (rest_hi - rest_lo);
 }
 
-void BoxOnSphereScene::Step(double dt) {
-  Scene::Step(dt);
+void BoxOnSphereScene::Measure(double /*dt*/) {
   const DeformableBody& sphere = world().deformable_body(0);
   for (int i = 0; i < sphere.num_nodes(); ++i) {
     const Vec3 p = sphere.node_position(i);

@@ -15,7 +15,8 @@ class BoxOnSphereScene : public Scene {
   // boxes of 20, 10 and 5 kg (0.4, 0.3 and 0.2 m cubes).
   explicit BoxOnSphereScene(double youngs_modulus = 500e3, double u_max = 0.5);
 
-  void Step(double dt) override;
+  // Updates the run's largest penetration, box tilt, energy ratio and rigid contact rows.
+  void Measure(double dt) override;
   std::vector<std::string> CsvColumns() const override;
   void AppendCsvValues(std::vector<double>& values) const override;
   void WriteFigures(nlohmann::json& figures) const override;

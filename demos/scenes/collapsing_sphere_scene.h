@@ -32,7 +32,8 @@ class CollapsingSphereScene : public Scene {
   // U_max of the energy meter of unlimited spheres [J] (the paper's limit).
   static constexpr double kMeterEnergy = 50.0;
 
-  void Step(double dt) override;
+  // Updates the run's extremes (lowest point, flattening, energy and volume ratios, step time).
+  void Measure(double dt) override;
   std::vector<std::string> CsvColumns() const override;
   void AppendCsvValues(std::vector<double>& values) const override;
   void WriteFigures(nlohmann::json& figures) const override;

@@ -27,10 +27,10 @@ FallingSphereScene::FallingSphereScene(const std::vector<Sphere>& spheres, doubl
         MakeSceneBodySettings(spheres[s].name, spheres[s].youngs_modulus, 500.0);
     settings.contact_margin = 0.05;
     DeformableBody* body = world().AddHexBody(lattice, settings);
-    limits_.push_back(spheres[s].u_max ? world().SetEnergyLimits(
-                                             body, EnergyLimitSettings::PerElementEnergy(
-                                                       *spheres[s].u_max))
-                                       : nullptr);
+    limits_.push_back(spheres[s].u_max
+                          ? world().SetEnergyLimits(
+                                body, EnergyLimitSettings::PerElementEnergy(*spheres[s].u_max))
+                          : nullptr);
   }
   landed_.assign(spheres.size(), false);
   max_flattening_.assign(spheres.size(), 0.0);
@@ -38,7 +38,6 @@ FallingSphereScene::FallingSphereScene(const std::vector<Sphere>& spheres, doubl
   deepest_.assign(spheres.size(), 0.0);
   max_ratio_.assign(spheres.size(), 0.0);
 }
-
 
 double FallingSphereScene::CalcBottom(int s) const {
   const DeformableBody& body = world().deformable_body(s);
@@ -54,8 +53,7 @@ double FallingSphereScene::CalcTop(int s) const {
   return z;
 }
 
-void FallingSphereScene::Step(double dt) {
-  Scene::Step(dt);
+void FallingSphereScene::Measure(double /*dt*/) {
   for (size_t s = 0; s < landed_.size(); ++s) {
     const int b = static_cast<int>(s);
     const double bottom = CalcBottom(b);

@@ -22,7 +22,8 @@ class FallingSphereScene : public Scene {
   explicit FallingSphereScene(const std::vector<Sphere>& spheres, double cell_size = 0.5);
   static std::vector<Sphere> DefaultSpheres();
 
-  void Step(double dt) override;
+  // Updates landing, bounce and the run's extremes (lowest point, flattening, energy ratio).
+  void Measure(double dt) override;
   std::vector<std::string> CsvColumns() const override;
   void AppendCsvValues(std::vector<double>& values) const override;
   void WriteFigures(nlohmann::json& figures) const override;

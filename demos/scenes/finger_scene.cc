@@ -204,13 +204,13 @@ void FingerScene::UpdateBoneTravel(double dt) {
   bone_->setWorldTransform(pose);
 }
 
-void FingerScene::Step(double dt) {
-  if (current_ >= num_presses()) {
-    Scene::Step(dt);
-    return;
-  }
-  UpdateBoneTravel(dt);
-  Scene::Step(dt);
+void FingerScene::Simulate(double dt) {
+  if (current_ < num_presses()) UpdateBoneTravel(dt);
+  Scene::Simulate(dt);
+}
+
+void FingerScene::Measure(double dt) {
+  if (current_ >= num_presses()) return;
   MeasureStep();
   time_ += dt;
   if (stopped_) held_ += dt;

@@ -101,7 +101,10 @@ class FingerScene : public Scene {
   // Longest simulated time one press may take with these settings [s].
   static double CalcPressDuration(const FingerSceneSettings& settings);
 
-  void Step(double dt) override;
+  // Moves the bone (UpdateBoneTravel) and steps the world.
+  void Simulate(double dt) override;
+  // MeasureStep, then the press's clock; ends the press when its hold or duration is over.
+  void Measure(double dt) override;
   std::vector<std::string> CsvColumns() const override;
   void AppendCsvValues(std::vector<double>& values) const override;
   void WriteFigures(nlohmann::json& figures) const override;

@@ -9,7 +9,12 @@
 
 namespace taut {
 
-void Scene::Step(double dt) { world().stepSimulation(dt, 1, dt); }
+void Scene::Step(double dt) {
+  Simulate(dt);
+  Measure(dt);
+}
+
+void Scene::Simulate(double dt) { world().stepSimulation(dt, 1, dt); }
 
 void Scene::WriteVtkFrame(const std::string& dir, int frame, double time) const {
   if (time < 0.0) time = frame;
@@ -138,7 +143,8 @@ DeformableBodySettings MakeSceneBodySettings(const std::string& name, double you
 
 Vec3 CalcMeanDisplacement(const DeformableBody& body, const std::vector<int>& nodes) {
   Vec3 sum = Vec3::Zero();
-  for (int i : nodes) sum += body.node_position(i) - body.model().rest_positions().segment<3>(3 * i);
+  for (int i : nodes)
+    sum += body.node_position(i) - body.model().rest_positions().segment<3>(3 * i);
   return sum / static_cast<double>(nodes.size());
 }
 

@@ -1,4 +1,4 @@
-// A headless demo scene: built from options, stepped, and summarized (DESIGN.md "Demo output").
+// A headless demo scene: built from options, stepped, and summarized (docs/architecture.md §7).
 #pragma once
 
 #include <cstdint>
@@ -19,8 +19,14 @@ namespace taut {
 class Scene {
  public:
   virtual ~Scene() = default;
-  // Advances the scene by one step of length dt (one Bullet substep).
-  virtual void Step(double dt);
+  // Advances the scene by one step of length dt: Simulate(dt), then Measure(dt).
+  void Step(double dt);
+  // The simulation of one step of length dt: the scene's drivers (e.g. a kinematic bone's motion)
+  // and one Bullet substep. A step's timing (ms_step) covers this part only.
+  virtual void Simulate(double dt);
+  // The scene's own measurements of the step Simulate(dt) just took (energies, reactions, maxima
+  // for the figures) and the scene events decided by them; outside the timed part.
+  virtual void Measure(double /*dt*/) {}
   // Names of the scene-specific per-step CSV columns.
   virtual std::vector<std::string> CsvColumns() const { return {}; }
   // Values for CsvColumns() after the current step.

@@ -23,7 +23,8 @@ class TetBeamScene : public Scene {
   // Density 1000 kg/m^3, nu = 0.3.
   static std::vector<Beam> DefaultBeams();
 
-  void Step(double dt) override;
+  // Updates the run's largest tip displacement per beam.
+  void Measure(double dt) override;
   std::vector<std::string> CsvColumns() const override;
   void AppendCsvValues(std::vector<double>& values) const override;
   void WriteFigures(nlohmann::json& figures) const override;

@@ -29,8 +29,8 @@ VerticalBeamScene::VerticalBeamScene(const std::vector<StrainProjection>& modes,
     // Transverse axis x limited to 0.95..1.05; y and the vertical axis z free.
     const double free = kUnlimitedStretch;
     limits_.push_back(world().SetStrainLimits(
-        body, StrainLimitSettings::PerAxis(Vec3(0.95, 0.0, 0.0), Vec3(1.05, free, free),
-                                           modes[c])));
+        body,
+        StrainLimitSettings::PerAxis(Vec3(0.95, 0.0, 0.0), Vec3(1.05, free, free), modes[c])));
     std::vector<int> top;
     for (int i = 0; i < body->num_nodes(); ++i)
       if (mesh->nodes[i].z() > kHeight - 1e-9) top.push_back(i);
@@ -53,17 +53,15 @@ double VerticalBeamScene::CalcTopHeight(int c) const {
   return z / static_cast<double>(top_nodes_[c].size());
 }
 
-void VerticalBeamScene::Step(double dt) {
-  // Step the columns one at a time so each column's own solver statistics can be read.
-  Scene::Step(dt);
+void VerticalBeamScene::Measure(double dt) {
   ++step_;
   for (size_t c = 0; c < modes_.size(); ++c) {
     const double violation = limits_[c]->CalcMaxViolation(world().deformable_body(c).x0() +
                                                           dt * world().deformable_body(c).v_star());
     if (first_violation_[c] < 0 && violation > 0.0) first_violation_[c] = step_;
     max_strain_[c] = std::max(max_strain_[c], CalcLimitedAxisStrain(static_cast<int>(c)));
-    max_violation_after_[c] =
-        std::max(max_violation_after_[c], limits_[c]->CalcMaxViolation(world().deformable_body(c).x()));
+    max_violation_after_[c] = std::max(
+        max_violation_after_[c], limits_[c]->CalcMaxViolation(world().deformable_body(c).x()));
   }
 }
 

@@ -15,11 +15,13 @@ class VerticalBeamScene : public Scene {
   // The four modes of the issue.
   static std::vector<StrainProjection> AllModes();
 
-  void Step(double dt) override;
+  // Updates the first violation step and the largest limited-axis strain and violation.
+  void Measure(double dt) override;
   std::vector<std::string> CsvColumns() const override;
   void AppendCsvValues(std::vector<double>& values) const override;
   void WriteFigures(nlohmann::json& figures) const override;
-  // Pictures: start, the first limit violation of each mode (one frame when they coincide) and the end.
+  // Pictures: start, the first limit violation of each mode (one frame when they coincide) and the
+  // end.
   std::vector<KeyFrame> CollectKeyFrames(int step, int num_steps) override;
 
   // Largest strain |G e_x| - 1 over the elements of column c now.

@@ -118,7 +118,7 @@ inline std::string FormatReportMethod(const ReportHeader& h) {
        "and slip of sticking contacts, both in C units; `kkt_dual`: distance of lambda from its "
        "set relative to max |lambda|); `max LCP res.` the natural-map residual of the dual path's "
        "last QP; `max stat.` and `mean stat.` the SQP stationarity "
-       "||A(v - v*) - J^T lambda|| / ||J^T lambda|| at the end of a step (max and mean over steps "
+       "||A(v - v*) - J^T lambda|| / max(||J^T lambda||, ||A(v - v*)||) at the end of a step (max and mean over steps "
        "with rows); `traj. err.` the RMS over the 1/60 s sample times of "
        "sqrt(mean over free nodes of |x - x_ref|^2) / L, L the body's rest bounding-box "
        "diagonal. A dash means the scene or the step statistics do not expose the figure. "
