@@ -19,6 +19,14 @@ double MsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
       .count();
 }
+
+// Milliseconds since `lap`, which then restarts at now (stage timers; no allocation).
+double LapMs(std::chrono::steady_clock::time_point& lap) {
+  const auto now = std::chrono::steady_clock::now();
+  const double ms = std::chrono::duration<double, std::milli>(now - lap).count();
+  lap = now;
+  return ms;
+}
 }  // namespace
 
 DeformableWorld::DeformableWorld(btDispatcher* dispatcher, btBroadphaseInterface* broadphase,
@@ -100,15 +108,15 @@ T* DeformableWorld::ReplaceSource(DeformableBody* body, std::unique_ptr<T> sourc
 StrainLimitConstraint* DeformableWorld::SetStrainLimits(DeformableBody* body,
                                                         const StrainLimitSettings& limits) {
   FindEntry(body);  // names a foreign body before anything is built
-  return ReplaceSource(
-      body, std::make_unique<StrainLimitConstraint>(*body, limits, next_source_id_++));
+  return ReplaceSource(body,
+                       std::make_unique<StrainLimitConstraint>(*body, limits, next_source_id_++));
 }
 
 EnergyLimitConstraint* DeformableWorld::SetEnergyLimits(DeformableBody* body,
                                                         const EnergyLimitSettings& limits) {
   FindEntry(body);
-  return ReplaceSource(
-      body, std::make_unique<EnergyLimitConstraint>(*body, limits, next_source_id_++));
+  return ReplaceSource(body,
+                       std::make_unique<EnergyLimitConstraint>(*body, limits, next_source_id_++));
 }
 
 RigidIslandBody* DeformableWorld::FindRigidIslandBody(btRigidBody* rigid) {
@@ -124,14 +132,15 @@ void DeformableWorld::AttachNodesToRigidBody(DeformableBody* body, const std::ve
   // The world's own (non-const) pointer to the rigid body.
   btRigidBody* owned = nullptr;
   for (int i = 0; i < getNumCollisionObjects(); ++i)
-    if (getCollisionObjectArray()[i] == rigid) owned = btRigidBody::upcast(getCollisionObjectArray()[i]);
+    if (getCollisionObjectArray()[i] == rigid)
+      owned = btRigidBody::upcast(getCollisionObjectArray()[i]);
   TAUT_DEMAND(owned != nullptr, "body '", body->name(),
               "': AttachNodesToRigidBody: the rigid body is not in this world");
   const btTransform inverse = rigid->getWorldTransform().inverse();
   std::vector<Vec3> local;
   for (int node : nodes) {
-    TAUT_DEMAND(node >= 0 && node < body->num_nodes(), "body '", body->name(),
-                "': attached node ", node, " out of range [0, ", body->num_nodes(), ")");
+    TAUT_DEMAND(node >= 0 && node < body->num_nodes(), "body '", body->name(), "': attached node ",
+                node, " out of range [0, ", body->num_nodes(), ")");
     local.push_back(ToEigen(inverse * ToBullet(body->node_position(node))));
   }
   if (rigid->isStaticOrKinematicObject()) {
@@ -158,7 +167,7 @@ void DeformableWorld::SetContactSurface(DeformableBody* body, const SurfaceMesh&
   entry.surface = std::move(embedded);
   for (auto it = pair_contacts_.begin(); it != pair_contacts_.end();)
     it = (it->first.first == &entry || it->first.second == &entry) ? pair_contacts_.erase(it)
-                                                                    : std::next(it);
+                                                                   : std::next(it);
 }
 
 void DeformableWorld::ClearLimits(DeformableBody* body) { FindEntry(body).sources.clear(); }
@@ -183,8 +192,8 @@ void DeformableWorld::internalSingleStepSimulation(btScalar h) {
   const auto start = std::chrono::steady_clock::now();
   btDiscreteDynamicsWorld::internalSingleStepSimulation(h);  // calls solveConstraints below
   stats_.ms_total = MsSince(start);
-  stats_.ms_rigid = stats_.ms_total - stats_.ms_unconstrained - stats_.ms_rows -
-                    stats_.ms_solve - stats_.ms_integrate;
+  stats_.ms_rigid = stats_.ms_total - stats_.ms_unconstrained - stats_.ms_rows - stats_.ms_solve -
+                    stats_.ms_integrate;
 }
 
 void DeformableWorld::UpdateKinematicAttachments() {
@@ -218,65 +227,96 @@ bool Overlaps(const Vec3& lo, const Vec3& hi, const btBroadphaseProxy& proxy) {
   const Vec3 plo = ToEigen(proxy.m_aabbMin), phi = ToEigen(proxy.m_aabbMax);
   return (lo.array() <= phi.array()).all() && (plo.array() <= hi.array()).all();
 }
+
+// Narrowphase set-up of a contact partner's shape, once per shape when a deformable first comes
+// near it: face planes of polyhedral shapes give exact inside distances (point_shape_distance.cc);
+// boxes have their own closed form. Not done when the shape is added to the world: face planes
+// also switch Bullet's own convex-convex contacts to polyhedral clipping, which must stay stock
+// for rigid objects no deformable comes near.
+void PrepareNarrowphaseShape(btCollisionShape& shape) {
+  if (!shape.isPolyhedral() || shape.getShapeType() == BOX_SHAPE_PROXYTYPE) return;
+  auto& polyhedral = static_cast<btPolyhedralConvexShape&>(shape);
+  if (polyhedral.getConvexPolyhedron() == nullptr) polyhedral.initializePolyhedralFeatures();
+}
 }  // namespace
 
-int DeformableWorld::DynamicIndex(const btCollisionObject& object) const {
-  const int i = object.getWorldArrayIndex();
-  return i >= 0 && i < static_cast<int>(dynamic_index_.size()) ? dynamic_index_[i] : -1;
+void DeformableWorld::StepDeformables(double h, btContactSolverInfo& info, int& begun) {
+  auto lap = std::chrono::steady_clock::now();
+  BeginDeformableSteps(h, begun);  // 2. unconstrained deformable step
+  stats_.ms_stage_begin_steps = LapMs(lap);
+  FindContactPartners(h);  // 3. collision detection: deformables vs rigid objects and each other
+  stats_.ms_stage_partners = LapMs(lap);
+  UniteIslands();  // 4. islands
+  stats_.ms_stage_islands = LapMs(lap);
+  CoupleRigidBodies(h);  // 4. rigid bodies of deformable islands
+  stats_.ms_stage_couple_rigid = LapMs(lap);
+  GatherRowSources(info);  // 5. rows per island
+  stats_.ms_stage_row_sources = LapMs(lap);
+  SolveRigidIslandsWithBullet(info);  // 6. rigid-only islands
+  stats_.ms_stage_bullet_solver = LapMs(lap);
+  SolveIslands(h);  // 6. deformable islands
+  stats_.ms_stage_solve_islands = LapMs(lap);
+  EndSteps(h);  // 7. integrate (Bullet integrates the rigid transforms next)
+  stats_.ms_stage_end_steps = LapMs(lap);
+  SumStageStats();  // 8. stats
 }
 
-void DeformableWorld::BuildIslands(double h, const btContactSolverInfo& info) {
-  const int num_deformables = static_cast<int>(bodies_.size());
-  const btCollisionObjectArray& objects = getCollisionObjectArray();
-  // Dynamic rigid bodies get union-find indices after the deformables.
-  dynamic_.clear();
-  dynamic_index_.assign(objects.size(), -1);
-  for (int i = 0; i < objects.size(); ++i) {
-    btRigidBody* rigid = btRigidBody::upcast(objects[i]);
-    if (rigid == nullptr || rigid->isStaticOrKinematicObject()) continue;
-    if (rigid->getCollisionShape()->getShapeType() == kDeformableShapeType) continue;
-    dynamic_index_[i] = num_deformables + static_cast<int>(dynamic_.size());
-    dynamic_.push_back(rigid);
+void DeformableWorld::SumStageStats() {
+  stats_.ms_unconstrained = stats_.ms_stage_begin_steps;
+  stats_.ms_rows += stats_.ms_stage_partners + stats_.ms_stage_islands +
+                    stats_.ms_stage_couple_rigid + stats_.ms_stage_row_sources;
+  stats_.ms_integrate = stats_.ms_stage_end_steps;
+  stats_.rigid_bodies_coupled = static_cast<int>(coupled_.size());
+}
+
+void DeformableWorld::BeginDeformableSteps(double h, int& begun) {
+  UpdateKinematicAttachments();
+  const Vec3 gravity = ToEigen(getGravity());
+  for (auto& entry : bodies_) {
+    ++begun;
+    entry->body().BeginStep(h, gravity);
   }
-  union_find_.Reset(num_deformables + static_cast<int>(dynamic_.size()));
-  // Deformable-rigid pairs whose bounds overlap (everything else skips the narrow phase).
+}
+
+void DeformableWorld::FindContactPartners(double h) {
+  // Rigid partners may move too: each body's reach grows by the fastest rigid motion this step.
   double max_rigid_speed = 0.0;
-  for (btRigidBody* rigid : dynamic_)
-    max_rigid_speed = std::max(max_rigid_speed, static_cast<double>(rigid->getLinearVelocity().length()));
-  for (int d = 0; d < num_deformables; ++d) {
-    Entry& entry = *bodies_[d];
-    entry.partners.clear();
-    CalcSweptBounds(entry.body(), h, entry.body().settings().contact_margin, entry.swept_lo,
-                    entry.swept_hi);
-    // Rigid partners may move too: grow by their fastest motion this step.
-    const Vec3 lo = entry.swept_lo.array() - h * max_rigid_speed;
-    const Vec3 hi = entry.swept_hi.array() + h * max_rigid_speed;
-    for (int i = 0; i < objects.size(); ++i) {
-      const btCollisionObject* object = objects[i];
-      if (object->getCollisionShape()->getShapeType() == kDeformableShapeType) continue;
-      if (object->hasContactResponse() == false || object->getBroadphaseHandle() == nullptr)
-        continue;
-      if (!Overlaps(lo, hi, *object->getBroadphaseHandle())) continue;
-      // Face planes of polyhedral shapes (made once per shape) give exact inside distances.
-      if (object->getCollisionShape()->isPolyhedral() &&
-          object->getCollisionShape()->getShapeType() != BOX_SHAPE_PROXYTYPE) {
-        auto* shape = const_cast<btPolyhedralConvexShape*>(
-            static_cast<const btPolyhedralConvexShape*>(object->getCollisionShape()));
-        if (shape->getConvexPolyhedron() == nullptr) shape->initializePolyhedralFeatures();
-      }
-      if (dynamic_index_[i] >= 0) {
-        union_find_.Unite(d, dynamic_index_[i]);
-        entry.partners.push_back({object, nullptr});  // rigid island body filled in below
-      } else if (object->isStaticOrKinematicObject()) {
-        entry.partners.push_back({object, nullptr});
-      }
-    }
-    for (const auto& attachment : entry.dynamic_attachments)
-      if (DynamicIndex(*attachment->rigid()->rigid()) >= 0)
-        union_find_.Unite(d, DynamicIndex(*attachment->rigid()->rigid()));
+  const btCollisionObjectArray& objects = getCollisionObjectArray();
+  for (int i = 0; i < objects.size(); ++i)
+    if (IslandBuilder::IsDynamicRigidBody(*objects[i]))
+      max_rigid_speed = std::max(
+          max_rigid_speed,
+          static_cast<double>(btRigidBody::upcast(objects[i])->getLinearVelocity().length()));
+  for (auto& entry : bodies_) {
+    CalcSweptBounds(entry->body(), h, entry->body().settings().contact_margin, entry->swept_lo,
+                    entry->swept_hi);
+    FindRigidPartners(*entry, h * max_rigid_speed);
   }
-  // Deformables whose swept bounds overlap share an island and a pair contact source.
+  FindDeformablePairs();
+}
+
+void DeformableWorld::FindRigidPartners(Entry& entry, double reach) {
+  entry.partners.clear();
+  const Vec3 lo = entry.swept_lo.array() - reach;
+  const Vec3 hi = entry.swept_hi.array() + reach;
+  btCollisionObjectArray& objects = getCollisionObjectArray();
+  for (int i = 0; i < objects.size(); ++i) {
+    btCollisionObject* object = objects[i];
+    btCollisionShape* shape = object->getCollisionShape();
+    if (shape->getShapeType() == kDeformableShapeType) continue;
+    if (!object->hasContactResponse() || object->getBroadphaseHandle() == nullptr) continue;
+    if (!Overlaps(lo, hi, *object->getBroadphaseHandle())) continue;
+    PrepareNarrowphaseShape(*shape);
+    // Static, kinematic and dynamic rigid objects; the island body of a dynamic one is set in
+    // CoupleRigidBodies.
+    if (IslandBuilder::IsDynamicRigidBody(*object) || object->isStaticOrKinematicObject())
+      entry.partners.push_back({object, nullptr});
+  }
+}
+
+void DeformableWorld::FindDeformablePairs() {
   active_pairs_.clear();
+  const int num_deformables = static_cast<int>(bodies_.size());
   for (int d = 0; d < num_deformables; ++d) {
     for (int e = d + 1; e < num_deformables; ++e) {
       const Entry& first = *bodies_[d];
@@ -284,7 +324,7 @@ void DeformableWorld::BuildIslands(double h, const btContactSolverInfo& info) {
       if ((first.swept_lo.array() > second.swept_hi.array()).any() ||
           (second.swept_lo.array() > first.swept_hi.array()).any())
         continue;
-      union_find_.Unite(d, e);
+      // The pair's source is kept across steps for its warm starts.
       auto& source = pair_contacts_[{&first, &second}];
       if (source == nullptr) {
         const DeformableBodySettings& a = first.object->body().settings();
@@ -294,102 +334,69 @@ void DeformableWorld::BuildIslands(double h, const btContactSolverInfo& info) {
             next_source_id_++, a.friction * b.friction,
             std::max(a.contact_margin, b.contact_margin));
       }
-      active_pairs_.emplace_back(d, source.get());
+      active_pairs_.push_back({d, e, source.get()});
     }
   }
-  // Rigid bodies touching each other (Bullet's manifolds with points) share an island.
-  btDispatcher* dispatcher = getDispatcher();
-  for (int m = 0; m < dispatcher->getNumManifolds(); ++m) {
-    const btPersistentManifold* manifold = dispatcher->getManifoldByIndexInternal(m);
-    if (manifold->getNumContacts() == 0) continue;
-    const int a = DynamicIndex(*manifold->getBody0());
-    const int b = DynamicIndex(*manifold->getBody1());
-    if (a >= 0 && b >= 0) union_find_.Unite(a, b);
-  }
-  // So do rigid bodies joined by Bullet joints.
-  for (int j = 0; j < getNumConstraints(); ++j) {
-    const btTypedConstraint* joint = getConstraint(j);
-    if (!joint->isEnabled()) continue;
-    const int a = DynamicIndex(joint->getRigidBodyA());
-    const int b = DynamicIndex(joint->getRigidBodyB());
-    if (a >= 0 && b >= 0) union_find_.Unite(a, b);
-  }
-  // Islands: one per root that holds a deformable (deformables are the lowest indices, so the
-  // root of an island with deformables is its first deformable).
-  island_of_root_.assign(num_deformables, -1);
-  num_islands_ = 0;
+}
+
+void DeformableWorld::UniteIslands() {
+  const int num_deformables = static_cast<int>(bodies_.size());
+  islands_.Reset(num_deformables, getCollisionObjectArray());
   for (int d = 0; d < num_deformables; ++d) {
-    const int root = union_find_.Find(d);
-    if (island_of_root_[root] < 0) {
-      if (static_cast<int>(islands_.size()) <= num_islands_) islands_.emplace_back();
-      Island& island = islands_[num_islands_];
-      island.bodies.clear();
-      island.sources.clear();
-      if (island.manifolds == nullptr)
-        island.manifolds = std::make_unique<RigidManifoldSource>(next_source_id_++);
-      if (island.joints == nullptr) island.joints = std::make_unique<JointSource>(next_source_id_++);
-      island.manifolds->Clear();
-      island.joints->Clear();
-      island.first_entry = d;
-      island_of_root_[root] = num_islands_++;
+    const Entry& entry = *bodies_[d];
+    for (const ContactPartner& partner : entry.partners) {
+      const int index = islands_.DynamicIndex(*partner.object);
+      if (index >= 0) islands_.Unite(d, index);
     }
-    Entry& entry = *bodies_[d];
-    entry.island = island_of_root_[root];
-    islands_[entry.island].bodies.push_back(entry.island_body.get());
+    for (const auto& attachment : entry.dynamic_attachments) {
+      const int index = islands_.DynamicIndex(*attachment->rigid()->rigid());
+      if (index >= 0) islands_.Unite(d, index);
+    }
   }
-  // Coupled rigid bodies: start their step before Bullet's solver changes their velocity.
+  for (const DeformablePair& pair : active_pairs_) islands_.Unite(pair.first, pair.second);
+  islands_.UniteTouchingRigidBodies(*getDispatcher());
+  islands_.UniteJointedRigidBodies(*this);
+  islands_.MakeDeformableIslands(next_source_id_);
+  for (int d = 0; d < num_deformables; ++d) {
+    Entry& entry = *bodies_[d];
+    entry.island = islands_.island_of_deformable(d);
+    islands_.island(entry.island).bodies.push_back(entry.island_body.get());
+  }
+}
+
+void DeformableWorld::CoupleRigidBodies(double h) {
   coupled_.clear();
-  for (size_t k = 0; k < dynamic_.size(); ++k) {
-    const int root = union_find_.Find(num_deformables + static_cast<int>(k));
-    if (root >= num_deformables) continue;  // a rigid island: Bullet's alone
-    RigidIslandBody* body = FindRigidIslandBody(dynamic_[k]);
-    dynamic_[k]->activate();  // Bullet's sleeping test does not see deformable contacts
+  const int first_dynamic = static_cast<int>(bodies_.size());
+  for (int k = 0; k < islands_.num_dynamic_bodies(); ++k) {
+    const int island = islands_.IslandOf(first_dynamic + k);
+    if (island < 0) continue;  // a rigid-only island: Bullet's alone
+    btRigidBody* rigid = islands_.dynamic_body(first_dynamic + k);
+    RigidIslandBody* body = FindRigidIslandBody(rigid);
+    rigid->activate();  // Bullet's sleeping test does not see deformable contacts
     body->BeginStep(h);
     coupled_.push_back(body);
-    islands_[island_of_root_[root]].bodies.push_back(body);
+    islands_.island(island).bodies.push_back(body);
   }
   for (auto& entry : bodies_)
     for (ContactPartner& partner : entry->partners) {
-      const int index = DynamicIndex(*partner.object);
-      if (index >= 0) partner.rigid = FindRigidIslandBody(dynamic_[index - num_deformables]);
+      const int index = islands_.DynamicIndex(*partner.object);
+      if (index >= 0) partner.rigid = FindRigidIslandBody(islands_.dynamic_body(index));
     }
-  // Manifolds touching a coupled body go into its island's SQP.
-  for (int m = 0; m < dispatcher->getNumManifolds(); ++m) {
-    const btPersistentManifold* manifold = dispatcher->getManifoldByIndexInternal(m);
-    if (manifold->getNumContacts() == 0) continue;
-    int root = -1;
-    const RigidIslandBody* sides[2] = {nullptr, nullptr};
-    const btCollisionObject* objects_ab[2] = {manifold->getBody0(), manifold->getBody1()};
-    for (int s = 0; s < 2; ++s) {
-      const int index = DynamicIndex(*objects_ab[s]);
-      if (index < 0) continue;
-      const int r = union_find_.Find(index);
-      if (r >= num_deformables) continue;
-      root = r;
-      sides[s] = FindRigidIslandBody(dynamic_[index - num_deformables]);
-    }
-    if (root >= 0)
-      islands_[island_of_root_[root]].manifolds->AddManifold(*manifold, sides[0], sides[1], info);
-  }
-  // Joints touching a coupled body too.
-  for (int j = 0; j < getNumConstraints(); ++j) {
-    btTypedConstraint* joint = getConstraint(j);
-    const btRigidBody* bodies[2] = {&joint->getRigidBodyA(), &joint->getRigidBodyB()};
-    const RigidIslandBody* sides[2] = {nullptr, nullptr};
-    int root = -1;
-    for (int s = 0; s < 2; ++s) {
-      const int index = DynamicIndex(*bodies[s]);
-      if (index < 0) continue;
-      const int r = union_find_.Find(index);
-      if (r >= num_deformables) continue;
-      root = r;
-      sides[s] = FindRigidIslandBody(dynamic_[index - num_deformables]);
-    }
-    if (root >= 0) islands_[island_of_root_[root]].joints->AddJoint(*joint, sides[0], sides[1], info);
-  }
-  // Row sources of each island.
+}
+
+RigidIslandBody* DeformableWorld::FindCoupledBody(const btCollisionObject& object, int& island) {
+  const int index = islands_.DynamicIndex(object);
+  if (index < 0) return nullptr;
+  const int coupled_island = islands_.IslandOf(index);
+  if (coupled_island < 0) return nullptr;
+  island = coupled_island;
+  return FindRigidIslandBody(islands_.dynamic_body(index));
+}
+
+void DeformableWorld::GatherRowSources(const btContactSolverInfo& info) {
+  AddCoupledManifoldsAndJoints(info);
   for (auto& entry : bodies_) {
-    Island& island = islands_[entry->island];
+    Island& island = islands_.island(entry->island);
     for (auto& source : entry->sources) island.sources.push_back(source.get());
     if (!entry->partners.empty()) {
       entry->contacts->set_partners(entry->partners);
@@ -397,12 +404,61 @@ void DeformableWorld::BuildIslands(double h, const btContactSolverInfo& info) {
     }
     for (auto& attachment : entry->dynamic_attachments) island.sources.push_back(attachment.get());
   }
-  for (const auto& [d, source] : active_pairs_) islands_[bodies_[d]->island].sources.push_back(source);
-  for (int i = 0; i < num_islands_; ++i) {
-    if (islands_[i].manifolds->num_points() > 0)
-      islands_[i].sources.push_back(islands_[i].manifolds.get());
-    if (islands_[i].joints->num_rows() > 0) islands_[i].sources.push_back(islands_[i].joints.get());
+  for (const DeformablePair& pair : active_pairs_)
+    islands_.island(bodies_[pair.first]->island).sources.push_back(pair.source);
+  for (int i = 0; i < islands_.num_islands(); ++i) {
+    Island& island = islands_.island(i);
+    if (island.manifolds->num_points() > 0) island.sources.push_back(island.manifolds.get());
+    if (island.joints->num_rows() > 0) island.sources.push_back(island.joints.get());
   }
+}
+
+void DeformableWorld::AddCoupledManifoldsAndJoints(const btContactSolverInfo& info) {
+  btDispatcher* dispatcher = getDispatcher();
+  for (int m = 0; m < dispatcher->getNumManifolds(); ++m) {
+    const btPersistentManifold* manifold = dispatcher->getManifoldByIndexInternal(m);
+    if (manifold->getNumContacts() == 0) continue;
+    int island = -1;
+    const RigidIslandBody* a = FindCoupledBody(*manifold->getBody0(), island);
+    const RigidIslandBody* b = FindCoupledBody(*manifold->getBody1(), island);
+    if (island >= 0) islands_.island(island).manifolds->AddManifold(*manifold, a, b, info);
+  }
+  for (int j = 0; j < getNumConstraints(); ++j) {
+    btTypedConstraint* joint = getConstraint(j);
+    int island = -1;
+    const RigidIslandBody* a = FindCoupledBody(joint->getRigidBodyA(), island);
+    const RigidIslandBody* b = FindCoupledBody(joint->getRigidBodyB(), island);
+    if (island >= 0) islands_.island(island).joints->AddJoint(*joint, a, b, info);
+  }
+}
+
+void DeformableWorld::SolveRigidIslandsWithBullet(btContactSolverInfo& info) {
+  // Bullet's solver runs on every rigid body, the coupled ones too, although their answer is
+  // replaced (EndSteps restores their transform and writes the island's velocity). Its pass over
+  // them must stay: it is what breaks a joint whose impulse exceeds its breaking threshold
+  // (JointSource only bounds the multiplier by it), and it writes the manifold points' impulses
+  // and friction directions and the joints' applied impulses, which Bullet warm-starts from once
+  // the bodies are back in a rigid-only island and which users read. Leaving the coupled bodies
+  // out (an island callback that skips them) keeps the determinism pins, but a breakable joint on
+  // a box resting on a soft block then never breaks, and the run diverges.
+  btDiscreteDynamicsWorld::solveConstraints(info);
+}
+
+void DeformableWorld::SolveIslands(double h) {
+  for (int i = 0; i < islands_.num_islands(); ++i) {
+    Island& island = islands_.island(i);
+    if (island.sources.empty()) continue;
+    StepStats island_stats;
+    bodies_[island.first_deformable]->solver.Solve(h, island.bodies, island.sources,
+                                                   solver_settings_, island_stats);
+    AccumulateStats(island_stats);
+    stats_.islands++;
+  }
+}
+
+void DeformableWorld::EndSteps(double h) {
+  for (auto& entry : bodies_) entry->body().EndStep(h);
+  for (RigidIslandBody* rigid : coupled_) rigid->EndStep();
 }
 
 void DeformableWorld::AccumulateStats(const StepStats& island_stats) {
@@ -426,13 +482,16 @@ void DeformableWorld::AccumulateStats(const StepStats& island_stats) {
   stats_.islands_primal += island_stats.islands_primal;
   stats_.newton_iterations += island_stats.newton_iterations;
   stats_.pcg_iterations += island_stats.pcg_iterations;
+  stats_.newton_factorizations += island_stats.newton_factorizations;
   stats_.kkt_primal = std::max(stats_.kkt_primal, island_stats.kkt_primal);
-  stats_.kkt_complementarity = std::max(stats_.kkt_complementarity, island_stats.kkt_complementarity);
+  stats_.kkt_complementarity =
+      std::max(stats_.kkt_complementarity, island_stats.kkt_complementarity);
   stats_.kkt_dual = std::max(stats_.kkt_dual, island_stats.kkt_dual);
   for (int i = 0; i < 5; ++i) {
-    stats_.kkt_primal_by_type[i] = std::max(stats_.kkt_primal_by_type[i], island_stats.kkt_primal_by_type[i]);
-    stats_.kkt_complementarity_by_type[i] =
-        std::max(stats_.kkt_complementarity_by_type[i], island_stats.kkt_complementarity_by_type[i]);
+    stats_.kkt_primal_by_type[i] =
+        std::max(stats_.kkt_primal_by_type[i], island_stats.kkt_primal_by_type[i]);
+    stats_.kkt_complementarity_by_type[i] = std::max(stats_.kkt_complementarity_by_type[i],
+                                                     island_stats.kkt_complementarity_by_type[i]);
   }
 }
 
@@ -454,40 +513,6 @@ void DeformableWorld::solveConstraints(btContactSolverInfo& info) {
     for (RigidIslandBody* rigid : coupled_) rigid->AbortStep();
     throw;
   }
-}
-
-void DeformableWorld::StepDeformables(double h, btContactSolverInfo& info, int& begun) {
-  // Stage 2: unconstrained implicit step of every deformable body.
-  const Vec3 gravity = ToEigen(getGravity());
-  UpdateKinematicAttachments();
-  auto t = std::chrono::steady_clock::now();
-  for (auto& entry : bodies_) {
-    ++begun;
-    entry->body().BeginStep(h, gravity);
-  }
-  stats_.ms_unconstrained = MsSince(t);
-  // Stage 3: islands; then Bullet's solver for every rigid island (bodies coupled to
-  // deformables are restored and solved again below, with the deformables).
-  t = std::chrono::steady_clock::now();
-  BuildIslands(h, info);
-  stats_.ms_rows += MsSince(t);
-  btDiscreteDynamicsWorld::solveConstraints(info);
-  // Stages 4-6: one SQP per island with rows (no rows: no LCP at all).
-  for (int i = 0; i < num_islands_; ++i) {
-    Island& island = islands_[i];
-    if (island.sources.empty()) continue;
-    StepStats island_stats;
-    bodies_[island.first_entry]->solver.Solve(h, island.bodies, island.sources, solver_settings_,
-                                              island_stats);
-    AccumulateStats(island_stats);
-    stats_.islands++;
-  }
-  stats_.rigid_bodies_coupled = static_cast<int>(coupled_.size());
-  // Stage 7: x = x0 + h v (Bullet integrates the rigid transforms next).
-  t = std::chrono::steady_clock::now();
-  for (auto& entry : bodies_) entry->body().EndStep(h);
-  for (RigidIslandBody* rigid : coupled_) rigid->EndStep();
-  stats_.ms_integrate = MsSince(t);
 }
 
 }  // namespace taut

@@ -1,4 +1,4 @@
-// Bullet dynamics world that also steps taut deformable bodies (DESIGN.md "One step").
+// Bullet dynamics world that also steps taut deformable bodies (docs/architecture.md §3).
 #pragma once
 
 #include <BulletCollision/CollisionDispatch/btEmptyCollisionAlgorithm.h>
@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "bullet_bridge/deformable_collision_object.h"
+#include "bullet_bridge/island_builder.h"
 #include "bullet_bridge/joint_source.h"
 #include "bullet_bridge/node_attachment_source.h"
 #include "bullet_bridge/rigid_contact_source.h"
@@ -17,7 +18,6 @@
 #include "bullet_bridge/rigid_manifold_source.h"
 #include "constraints/deformable_contact_source.h"
 #include "constraints/deformable_island_body.h"
-#include "constraints/union_find.h"
 #include "constraints/energy_limit_constraint.h"
 #include "constraints/island_solver.h"
 #include "constraints/step_stats.h"
@@ -29,7 +29,7 @@ namespace taut {
 
 // Drop-in replacement for btDiscreteDynamicsWorld. Deformable bodies live in Bullet's broadphase
 // as btCollisionObjects (AABBs refreshed every substep) and are stepped inside stepSimulation's
-// fixed substeps together with the rigid bodies. Islands (DESIGN.md "Islands") join each
+// fixed substeps together with the rigid bodies. Islands (docs/architecture.md §4) join each
 // deformable body with the dynamic rigid bodies it touches or is attached to, and with the rigid
 // bodies those touch through Bullet's contact manifolds; every island is one SQP whose QPs hold
 // the limit rows, the deformable contact rows, the node attachments and Bullet's rigid-rigid
@@ -48,7 +48,7 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   DeformableBody* AddTetBody(std::shared_ptr<const TetMesh> mesh,
                              const DeformableBodySettings& settings);
   // Makes a co-rotational hex body from a lattice (validated; throws InputError) and adds it;
-  // `method` picks the element rotation (MATH.md §4). Ownership as for AddTetBody.
+  // `method` picks the element rotation (docs/math.md §4.4). Ownership as for AddTetBody.
   DeformableBody* AddHexBody(const HexLattice& lattice, const DeformableBodySettings& settings,
                              HexRotationMethod method = HexRotationMethod::kCenterPolar);
   DeformableBody* AddHexBody(std::shared_ptr<const HexLattice> lattice,
@@ -94,8 +94,8 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   // One fixed substep; Bullet's sequence calls solveConstraints below between collision
   // detection and the integration of the rigid transforms.
   void internalSingleStepSimulation(btScalar h) override;
-  // Deformable step (stages 2-7) and islands: unconstrained deformable step, islands, Bullet's
-  // solver for the rigid islands, one SQP per deformable island, x = x0 + h v.
+  // The deformable part of the substep, stages 2-7 (StepDeformables); Bullet's own solver for
+  // the rigid-only islands runs inside it. Every body goes back to the step start on failure.
   void solveConstraints(btContactSolverInfo& info) override;
 
  private:
@@ -122,23 +122,45 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
     DeformableBody& body() { return object->body(); }
     btCollisionObject& collision_object() { return object->collision_object(); }
   };
-  // One island of this step: bodies (deformables first), row sources, Bullet manifolds.
-  struct Island {
-    std::vector<IslandBody*> bodies;
-    std::vector<ConstraintSource*> sources;
-    std::unique_ptr<RigidManifoldSource> manifolds;
-    std::unique_ptr<JointSource> joints;
-    int first_entry = -1;  // its solver keeps the warm starts
+  // Two deformables whose swept bounds overlap this step, with their contact source.
+  struct DeformablePair {
+    int first, second;  // entry indices, first < second
+    DeformableContactSource* source;
   };
-  // Stages 2-7 (see solveConstraints); `begun` counts the bodies whose step has begun.
+  // Stages of the substep (docs/architecture.md §3), in order; `begun` counts the bodies whose step
+  // has begun, for the abort path of solveConstraints.
   void StepDeformables(double h, btContactSolverInfo& info, int& begun);
+  // Stage 2: kinematic targets of attached nodes, then every body's unconstrained step (v*, x*).
+  void BeginDeformableSteps(double h, int& begun);
+  // Stage 3: each deformable's swept bounds, the rigid objects and the deformables they overlap.
+  void FindContactPartners(double h);
+  // Stage 3 for one body: rigid objects whose bounds overlap its swept bounds grown by `reach`.
+  void FindRigidPartners(Entry& entry, double reach);
+  // Stage 3 for deformable pairs: overlapping swept bounds, each pair with its contact source.
+  void FindDeformablePairs();
+  // Stage 4: union-find islands of deformables, their partners and attached rigid bodies, and
+  // the rigid bodies joined to those by Bullet's manifolds and joints.
+  void UniteIslands();
+  // Stage 4: dynamic rigid bodies in deformable islands begin their step (before Bullet's solver
+  // touches them) and join their island's bodies; contact partners get their island bodies.
+  void CoupleRigidBodies(double h);
+  // Stage 5: each island's row sources, with Bullet's manifolds and joints of its rigid bodies.
+  void GatherRowSources(const btContactSolverInfo& info);
+  // Stage 5: manifolds and joints touching a coupled rigid body, added to that body's island.
+  void AddCoupledManifoldsAndJoints(const btContactSolverInfo& info);
+  // Stage 6 for the rigid-only islands: Bullet's own solver.
+  void SolveRigidIslandsWithBullet(btContactSolverInfo& info);
+  // Stage 6 for the deformable islands: one SQP per island with rows (no rows: no LCP at all).
+  void SolveIslands(double h);
+  // Stage 7: x = x0 + h v; coupled rigid bodies get their solved velocity back.
+  void EndSteps(double h);
+  // Stage 8: the substep's totals from the stage timers (the islands' SQP stats are in already).
+  void SumStageStats();
   // Drives nodes attached to static/kinematic rigid bodies to their current anchors.
   void UpdateKinematicAttachments();
-  // Contact partners of every deformable (bounds overlap), union-find islands, coupled rigid
-  // bodies (BeginStep before Bullet's solver touches them) and their manifolds.
-  void BuildIslands(double h, const btContactSolverInfo& info);
-  // Union-find index of a collision object: >= 0 for dynamic rigid bodies, else -1.
-  int DynamicIndex(const btCollisionObject& object) const;
+  // The island body of the dynamic rigid body `object` when it is in a deformable island (then
+  // `island` is set to that island), else null.
+  RigidIslandBody* FindCoupledBody(const btCollisionObject& object, int& island);
   // The island body of a dynamic rigid body (made on first use).
   RigidIslandBody* FindRigidIslandBody(btRigidBody* rigid);
   // Adds the SQP statistics of one island to the substep's.
@@ -154,16 +176,9 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   // Contact sources of deformable pairs (kept across steps for warm starts), and this step's.
   std::map<std::pair<const Entry*, const Entry*>, std::unique_ptr<DeformableContactSource>>
       pair_contacts_;
-  std::vector<std::pair<int, DeformableContactSource*>> active_pairs_;  // (first entry, source)
-  // Per-step scratch (kept to avoid allocations): dynamic rigid bodies, their union-find index
-  // by world array index, the coupled ones, islands.
-  std::vector<btRigidBody*> dynamic_;
-  std::vector<int> dynamic_index_;
-  std::vector<RigidIslandBody*> coupled_;
-  std::vector<int> island_of_root_;
-  std::vector<Island> islands_;
-  int num_islands_ = 0;
-  UnionFind union_find_;
+  std::vector<DeformablePair> active_pairs_;
+  IslandBuilder islands_;                  // this step's islands
+  std::vector<RigidIslandBody*> coupled_;  // rigid bodies in deformable islands, this step
   SqpSettings solver_settings_;
   int next_source_id_ = 0;
   btEmptyAlgorithm::CreateFunc empty_algorithm_;

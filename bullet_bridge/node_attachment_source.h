@@ -1,5 +1,5 @@
-// Deformable nodes pinned to a dynamic rigid body as bilateral SQP rows (DESIGN.md
-// "Attachments"): a bone and the flesh around it push and pull each other in the same solve.
+// Deformable nodes pinned to a dynamic rigid body as bilateral SQP rows
+// (docs/architecture.md §4): bone and flesh push and pull each other in the same solve.
 #pragma once
 
 #include <vector>

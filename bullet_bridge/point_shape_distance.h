@@ -1,5 +1,5 @@
-// Narrowphase for one deformable surface point against one Bullet collision shape (DESIGN.md
-// "One step", stage 3): signed gap, unit normal and closest point on the shape.
+// Narrowphase for one deformable surface point against one Bullet collision shape
+// (docs/architecture.md §3, stage 3): signed gap, unit normal and closest point on the shape.
 //
 // Which surface the gap is measured to (one rule: the surface Bullet's own rigid collisions use):
 //  - plane, sphere, capsule: the exact analytic surface (for sphere and capsule Bullet's margin is

@@ -1,5 +1,5 @@
 // Contacts of a deformable body's boundary nodes with Bullet rigid objects, as SQP rows: normal
-// C = gap >= 0 and two Coulomb friction rows on the disk (MATH.md §5). Static and kinematic
+// C = gap >= 0 and two Coulomb friction rows on the disk (docs/math.md §5.5). Static and kinematic
 // objects are immovable during the step (one-sided rows); dynamic rigid bodies of the island
 // take the reaction (two-sided rows: the node against the body's surface point).
 #pragma once

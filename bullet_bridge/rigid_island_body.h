@@ -1,5 +1,5 @@
-// A dynamic Bullet rigid body as a body of a deformable island (two-way coupling, DESIGN.md
-// "Islands"): velocity blocks (v, omega), A = diag(m I, I_world).
+// A dynamic Bullet rigid body as a body of a deformable island (two-way coupling,
+// docs/architecture.md §4): velocity blocks (v, omega), A = diag(m I, I_world).
 #pragma once
 
 #include <BulletDynamics/Dynamics/btRigidBody.h>

@@ -1,5 +1,5 @@
 // Bullet's rigid-rigid contacts inside a deformable island as SQP rows, so they are solved in the
-// same PGS sweeps as the deformables' limits and contacts (DESIGN.md "Islands").
+// same PGS sweeps as the deformables' limits and contacts (docs/architecture.md §4).
 #pragma once
 
 #include <BulletCollision/NarrowPhaseCollision/btPersistentManifold.h>

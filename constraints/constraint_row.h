@@ -25,7 +25,7 @@ enum class RowType : std::uint8_t {
   kJoint,         // Bullet joint rows and node attachments (bilateral)
 };
 
-// C(x) >= 0 linearized at the current iterate: C + J dx >= 0 (MATH.md §5), or C = 0 for a
+// C(x) >= 0 linearized at the current iterate: C + J dx >= 0 (docs/math.md §5.3), or C = 0 for a
 // bilateral row. J is sparse over at most two island bodies ("sides"): the nodes of side A
 // (body, nodes, J) and optionally of side B (body2, nodes2, J2). A rigid island body has two
 // velocity blocks, linear (block 0) and angular (block 1). C is dimensionless for limit rows, J
@@ -67,7 +67,7 @@ struct ConstraintRow {
 };
 
 // Two unit tangents t1, t2 completing the unit normal n to a right-handed frame (n, t1, t2 = n x t1):
-// the friction directions of a contact (MATH.md §5).
+// the friction directions of a contact (docs/math.md §5.5).
 inline void CalcContactTangents(const Vec3& n, Vec3& t1, Vec3& t2) {
   t1 = (std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized();
   t2 = n.cross(t1);
@@ -76,7 +76,7 @@ inline void CalcContactTangents(const Vec3& n, Vec3& t1, Vec3& t2) {
 // Source id of a row key (bits 48-63; every source packs its id there).
 inline int RowKeySource(std::uint64_t key) { return static_cast<int>(key >> 48); }
 
-// Receives curvature blocks of rows for the SQP metric / Newton matrix (MATH.md §5 curvature):
+// Receives curvature blocks of rows for the SQP metric / Newton matrix (docs/math.md §5.9):
 // blocks of weight * [-d^2 C / dx^2]_+ between two nodes of one deformable body.
 class CurvatureSink {
  public:

@@ -1,6 +1,6 @@
 // Contact between two deformable bodies: the contact points of each body against the surface
 // triangles of the other (vertex-triangle), as normal rows C = gap >= 0 with two Coulomb
-// friction rows on the disk (MATH.md §5), coupling both bodies in one island.
+// friction rows on the disk (docs/math.md §5.5), coupling both bodies in one island.
 #pragma once
 
 #include <vector>

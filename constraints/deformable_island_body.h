@@ -12,6 +12,7 @@ class DeformableIslandBody final : public IslandBody {
   explicit DeformableIslandBody(DeformableBody& body) : body_(&body) {}
   int num_blocks() const override { return body_->num_nodes(); }
   const VecX& v_star() const override { return body_->v_star(); }
+  const VecX& v_start() const override { return body_->v0(); }
   const VecX& v() const override { return body_->v(); }
   void set_v(const VecX& v) override { body_->mutable_v() = v; }
   void SolveSystemColumns(Eigen::Ref<MatX> columns) const override {
@@ -21,7 +22,7 @@ class DeformableIslandBody final : public IslandBody {
     body_->ApplySystemMatrix(v, out);
   }
   bool is_free_block(int i) const override { return body_->node_kind(i) == NodeKind::kFree; }
-  // x = x0 + h v (MATH.md §5: positions of the backward-Euler step).
+  // x = x0 + h v (docs/math.md §5.1: positions of the backward-Euler step).
   void CalcPositions(double h, const VecX& v, VecX& x) const override {
     x = body_->x0() + h * v;
   }
@@ -36,6 +37,7 @@ class DeformableIslandBody final : public IslandBody {
   }
   void FactorNewtonMatrix() override { body_->mutable_system().FactorNewtonMatrix(body_->name()); }
   void SolveNewton(Eigen::Ref<VecX> rhs) const override { body_->system().SolveNewton(rhs); }
+  double CalcNewtonRefactorCost() const override { return body_->system().CalcNewtonRefactorCost(); }
   void ApplyNewtonMatrix(const VecX& v, VecX& out) const override {
     body_->system().MultiplyNewton(v, out);
   }

@@ -65,7 +65,7 @@ void EnergyLimitConstraint::FillRow(const VecX& x, int e, ConstraintRow& row) co
     }
     return;
   }
-  // Hex: R recomputed from x, then frozen for the Jacobian (MATH.md §4).
+  // Hex: R recomputed from x, then frozen for the Jacobian (docs/math.md §4.5).
   const HexRestElement& rest = hexes_->rest(e);
   const HexNodes xe = hexes_->GatherElement(x, e);
   const Mat3 R = CalcHexRotation(rest, xe, hexes_->rotation_method());

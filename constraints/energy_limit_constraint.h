@@ -1,4 +1,5 @@
-// Energy limits of one tet or hex body as a source of SQP rows (paper B eq. 14; MATH.md §4-§5).
+// Energy limits of one tet or hex body as a source of SQP rows (paper B eq. 14;
+// docs/math.md §4-§5).
 #pragma once
 
 #include <vector>
@@ -12,8 +13,8 @@
 namespace taut {
 
 // Emits one row C = 1 - U_e/U_max,e per element (tet: 4 nodes, exact gradient; hex: 8 nodes,
-// J = f_e/U_max with the element rotation frozen at x, MATH.md §4) whose C is below the activation
-// margin.
+// J = f_e/U_max with the element rotation frozen at x, docs/math.md §4.5) whose C is below the
+// activation margin.
 class EnergyLimitConstraint final : public BodyConstraintSource {
  public:
   // `body` must be a tet or hex body; settings are validated (throws InputError naming the body).

@@ -5,7 +5,7 @@
 namespace taut {
 
 void CalcEnergyLimitJacobian(const Vec3* forces, int num_nodes, double u_max, Vec3* J) {
-  // dC/dx = -(1/U_max) dU/dx = f / U_max (MATH.md §4).
+  // dC/dx = -(1/U_max) dU/dx = f / U_max (docs/math.md §4.5).
   const double scale = 1.0 / u_max;
   for (int n = 0; n < num_nodes; ++n) J[n] = scale * forces[n];
 }
@@ -47,7 +47,7 @@ HexEnergyLimitRow CalcHexEnergyLimitRow(const HexRestElement& rest, const HexNod
   HexEnergyLimitRow row;
   row.energy = CalcCorotatedHexEnergy(rest, x, R);
   row.C = CalcEnergyLimitValue(row.energy, u_max);
-  // J = f_e / U_max with f_e = -R K_e (R^T x - X) (MATH.md §4, frozen R).
+  // J = f_e / U_max with f_e = -R K_e (R^T x - X) (docs/math.md §4.5, frozen R).
   const Vec24 f = CalcCorotatedHexForces(rest, x, R);
   std::array<Vec3, 8> forces, J;
   for (int n = 0; n < 8; ++n) forces[n] = f.segment<3>(3 * n);

@@ -1,4 +1,4 @@
-// A body of a constraint island as the SQP sees it (MATH.md §5): velocity blocks, the step's
+// A body of a constraint island as the SQP sees it (docs/math.md §5.2): velocity blocks, the step's
 // system matrix A, the unconstrained velocity v*, and positions at a velocity.
 #pragma once
 
@@ -20,6 +20,9 @@ class IslandBody {
   virtual int num_blocks() const = 0;
   // Unconstrained velocity of this step (3 * num_blocks).
   virtual const VecX& v_star() const = 0;
+  // Velocity at the step start, the previous step's answer: a predictor of this step's
+  // constrained velocity for the primal path's start (default: v*, no predictor).
+  virtual const VecX& v_start() const { return v_star(); }
   // Current velocity (the SQP's iterate is written back here at the end of a solve).
   virtual const VecX& v() const = 0;
   virtual void set_v(const VecX& v) = 0;
@@ -52,6 +55,10 @@ class IslandBody {
   virtual void SolveNewton(Eigen::Ref<VecX> rhs) const = 0;
   // out = H v (zero on blocks that do not move freely).
   virtual void ApplyNewtonMatrix(const VecX& v, VecX& out) const = 0;
+  // The factor of an earlier H, if held, preconditions the Newton step instead of a new factor
+  // (constraints/primal_solver.h, factor reuse): its cost in preconditioned CG iterations, or 0
+  // when no factor is held or refactoring is cheap (rigid bodies: 6 x 6).
+  virtual double CalcNewtonRefactorCost() const { return 0.0; }
 };
 
 // The bodies of an island with velocities and positions of one SQP iterate.

@@ -1,4 +1,4 @@
-// The constrained step of one island (DESIGN.md "One step", stage 6): the papers' dual path (PGS
+// The constrained step of one island (docs/architecture.md §3, stage 6): the papers' dual path (PGS
 // per QP inside the SQP, constraints/sqp_solver.h) or the primal path (augmented-Lagrangian Newton,
 // constraints/primal_solver.h), chosen per island and step. Both share rows, keys and warm starts.
 #pragma once
@@ -12,9 +12,9 @@ namespace taut {
 
 class IslandSolver {
  public:
-  // Rows per free DOF from which kAuto takes the primal path (measured, docs/solver.md "Choosing
-  // a path": the dual's cost grows like m n + m^2 per SQP iteration and W is rank-deficient once
-  // m approaches n; the primal's cost is one sparse factorization per Newton iteration).
+  // Rows per free DOF from which kAuto takes the primal path (docs/solver.md "Two paths"): the
+  // dual's cost grows like m n + m^2 per SQP iteration and W is rank-deficient once m approaches
+  // n; the primal's cost is one sparse factorization per Newton iteration.
   static constexpr double kPrimalRowsPerDof = 0.3;
 
   // Solves the island's step; the path taken is counted in stats.islands_dual / islands_primal.

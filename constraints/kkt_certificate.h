@@ -1,6 +1,6 @@
 // Convergence certificate of a constrained step (both island solvers): the KKT residuals of
 //   min 1/2 ||v - v*||_A^2  s.t.  C(x0 + h v) >= 0 (bilateral: = 0), friction on the Coulomb disk,
-// at the solver's final iterate (v, lambda) with the rows linearized there (MATH.md §5).
+// at the solver's final iterate (v, lambda) with the rows linearized there (docs/math.md §5.10).
 #pragma once
 
 #include <array>
@@ -23,16 +23,10 @@ struct KktResiduals {
   // Distance of lambda from its set (lambda >= 0; [lo, hi]; |lambda_t| <= mu lambda_n) relative to
   // max |lambda|.
   double dual = 0.0;
-  // True when every residual is within tolerance: primal and complementarity <= violation_tolerance
-// (C units), dual <= 1e-6, stationarity <= stationarity_tolerance.
-bool IsCertified(const KktResiduals& kkt, double violation_tolerance,
-                 double stationarity_tolerance);
-
-// Writes the residuals into the step's statistics (kkt_*, stationarity).
-void RecordKkt(const KktResiduals& kkt, StepStats& stats);
-
-// ||A(v - v*) - J^T lambda|| / ||J^T lambda|| on free blocks (0 when there is no force).
+  // ||A(v - v*) - J^T lambda|| / max(||J^T lambda||, ||A(v - v*)||) on free blocks.
   double stationarity = 0.0;
+  // Primal and complementarity within tolerance (stationarity and dual aside).
+  bool IsFeasible(double violation_tolerance) const;
 
   double max_primal() const;
   double max_complementarity() const;
@@ -51,8 +45,8 @@ bool IsCertified(const KktResiduals& kkt, double violation_tolerance,
 // Writes the residuals into the step's statistics (kkt_*, stationarity).
 void RecordKkt(const KktResiduals& kkt, StepStats& stats);
 
-// ||A(v - v*) - J^T lambda|| / ||J^T lambda|| over the free blocks of every body (0 force:
-// the absolute residual).
+// ||A(v - v*) - J^T lambda|| / max(||J^T lambda||, ||A(v - v*)||) over the free blocks of every
+// body (0 when both sides vanish).
 double CalcStationarity(const std::vector<IslandBody*>& bodies, const IslandRows& rows,
                         const VecX& lambda, const std::vector<VecX>& v, VecX& scratch);
 

@@ -1,4 +1,4 @@
-// Validation and residuals of the mixed complementarity problem (MATH.md §5).
+// Validation and residuals of the mixed complementarity problem (docs/math.md §5.4).
 #include "constraints/lcp_residual.h"
 
 #include <cmath>

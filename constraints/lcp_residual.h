@@ -1,4 +1,4 @@
-// The mixed complementarity problem solved by PGS (MATH.md §5) and its residuals.
+// The mixed complementarity problem solved by PGS (docs/math.md §5.4) and its residuals.
 //
 // Problem: find lambda with w = W lambda + q, W = J A^-1 J^T (m x m, symmetric PSD), and per row c
 //   box row (kUnilateral, kBilateral):  lambda_c in [lo_c, hi_c] and
@@ -32,7 +32,7 @@ enum class RowKind : std::uint8_t {
 
 // Shape of the friction set of one contact.
 enum class FrictionCone : std::uint8_t {
-  kDisk,  // ||(lambda_t1, lambda_t2)|| <= mu lambda_n (Coulomb; DESIGN.md step 6)
+  kDisk,  // ||(lambda_t1, lambda_t2)|| <= mu lambda_n (Coulomb; docs/math.md §5.4)
   kBox,   // |lambda_t1|, |lambda_t2| <= mu lambda_n each (lets ||lambda_t|| reach sqrt(2) mu
           // lambda_n)
 };

@@ -1,4 +1,4 @@
-// Projected Gauss-Seidel sweeps (MATH.md §5).
+// Projected Gauss-Seidel sweeps (docs/math.md §5.6).
 #include "constraints/pgs_solver.h"
 
 #include <cmath>

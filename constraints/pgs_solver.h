@@ -1,4 +1,5 @@
-// Projected Gauss-Seidel for the mixed complementarity problem of lcp_residual.h (MATH.md §5).
+// Projected Gauss-Seidel for the mixed complementarity problem of lcp_residual.h
+// (docs/math.md §5.6).
 //
 // Box rows (unilateral, bilateral, box-cone friction) get the scalar update
 //   lambda_c <- clamp(lambda_c - omega w_c / W_cc, lo_c, hi_c),   w_c = q_c + (W lambda)_c.
@@ -45,7 +46,7 @@ struct PgsStats {
   bool converged = false;    // a tolerance was met (also true for m = 0)
 };
 
-// Box-row update clamp(lambda_c - omega w_c / W_cc, lo, hi); W_cc > 0 (MATH.md §5 PGS).
+// Box-row update clamp(lambda_c - omega w_c / W_cc, lo, hi); W_cc > 0 (docs/math.md §5.6).
 inline double CalcBoxRowUpdate(double lambda_c, double w_c, double W_cc, double lo, double hi,
                                double omega) {
   return ClampToBox(lambda_c - omega * w_c / W_cc, lo, hi);

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <functional>
 #include <limits>
 
 namespace taut {
@@ -21,7 +20,7 @@ double Dot(const std::vector<VecX>& a, const std::vector<VecX>& b) {
 }
 
 // Projection of y onto the disk |y| <= r and its Jacobian D = dProj/dy:
-// inside I; outside (r/|y|)(I - y y^T/|y|^2) (MATH.md §5, Coulomb disk).
+// inside I; outside (r/|y|)(I - y y^T/|y|^2) (docs/math.md §5.8, Coulomb disk).
 Eigen::Vector2d ProjectOnDisk(const Eigen::Vector2d& y, double r, Eigen::Matrix2d* D) {
   const double norm = y.norm();
   if (norm <= r) {
@@ -56,15 +55,18 @@ double UpperBound(const ConstraintRow& row) {
   return row.bilateral ? row.hi : std::numeric_limits<double>::infinity();
 }
 
-// Collects curvature blocks of the sources into the solver's list.
+// Collects the sources' curvature blocks into a list (each source sums an element's rows and
+// emits one block per node pair of the element).
+template <typename Block>
 class CurvatureList final : public CurvatureSink {
  public:
-  template <typename Add>
-  explicit CurvatureList(Add&& add) : add_(std::forward<Add>(add)) {}
-  void AddBlock(int body, int a, int b, const Mat3& block) override { add_(body, a, b, block); }
+  explicit CurvatureList(std::vector<Block>& blocks) : blocks_(blocks) {}
+  void AddBlock(int body, int a, int b, const Mat3& block) override {
+    blocks_.push_back({body, a, b, block});
+  }
 
  private:
-  std::function<void(int, int, int, const Mat3&)> add_;
+  std::vector<Block>& blocks_;
 };
 }  // namespace
 
@@ -131,19 +133,7 @@ void PrimalSolver::CollectCurvature(double h, const std::vector<IslandBody*>& bo
     any = true;
   }
   if (!any) return;
-  // Rows of one element are adjacent: a block already listed for the element's node pair (within
-  // the last 64 entries, one element's worth) is summed into, not repeated.
-  CurvatureList sink([this](int body, int a, int b, const Mat3& block) {
-    const size_t first = curvature_.size() > 64 ? curvature_.size() - 64 : 0;
-    for (size_t i = curvature_.size(); i-- > first;) {
-      CurvatureBlock& g = curvature_[i];
-      if (g.body == body && g.a == a && g.b == b) {
-        g.block += block;
-        return;
-      }
-    }
-    curvature_.push_back({body, a, b, block});
-  });
+  CurvatureList<CurvatureBlock> sink(curvature_);
   const IslandIterate iterate(h, bodies, v_, rows_.positions());
   for (const ConstraintSource* source : sources)
     source->AddIslandCurvature(iterate, rows_.rows().data(), weights.data(), rows_.size(), sink);
@@ -202,7 +192,26 @@ void PrimalSolver::AddRowProduct(const std::vector<IslandBody*>& bodies, int p, 
   });
 }
 
-void PrimalSolver::AssembleNewtonMatrices(const std::vector<IslandBody*>& bodies) {
+void PrimalSolver::ChooseFactorReuse(const std::vector<IslandBody*>& bodies,
+                                     const PrimalSettings& settings) {
+  // A body keeps its last factor when factoring costs at least min_refactor_cost CG iterations,
+  // unless the last solve with a kept factor needed more than half the cheapest such cost.
+  any_stale_ = false;
+  stale_budget_ = std::numeric_limits<double>::infinity();
+  stale_.assign(bodies.size(), 0);
+  for (size_t b = 0; b < bodies.size(); ++b) {
+    const double cost = settings.reuse_factorization ? bodies[b]->CalcNewtonRefactorCost() : 0.0;
+    if (refactor_next_ || cost <= 0.0 || cost < settings.min_refactor_cost) continue;
+    stale_[b] = 1;
+    any_stale_ = true;
+    stale_budget_ = std::min(stale_budget_, 0.5 * cost);
+  }
+  refactor_next_ = false;
+}
+
+int PrimalSolver::AssembleNewtonMatrices(const std::vector<IslandBody*>& bodies) {
+  // Bodies that keep their factor need no new H: their step is CG on the exact operator.
+  if (std::all_of(stale_.begin(), stale_.end(), [](char s) { return s != 0; })) return 0;
   for (IslandBody* body : bodies) body->ResetNewtonMatrix();
   for (const CurvatureBlock& g : curvature_) bodies[g.body]->AddNewtonBlock(g.a, g.b, g.block);
   // Rows of one element are adjacent and share its nodes: their rho J^T J are summed into one
@@ -231,14 +240,20 @@ void PrimalSolver::AssembleNewtonMatrices(const std::vector<IslandBody*>& bodies
     group_.Add(row, rho_[c] * d_unit_[c]);
   }
   group_.Scatter(bodies);
+  int factored = 0;
   try {
-    for (IslandBody* body : bodies) body->FactorNewtonMatrix();
+    for (size_t b = 0; b < bodies.size(); ++b) {
+      if (stale_[b]) continue;
+      bodies[b]->FactorNewtonMatrix();
+      ++factored;
+    }
   } catch (const SimulationError&) {
     // The curvature is only a metric: without it H = A + sum rho J^T D J is positive definite.
     if (curvature_.empty()) throw;
     curvature_.clear();
-    AssembleNewtonMatrices(bodies);
+    return factored + AssembleNewtonMatrices(bodies);
   }
+  return factored;
 }
 
 void PrimalSolver::RowGroup::Clear() { num_nodes = 0; }
@@ -306,13 +321,18 @@ void PrimalSolver::ApplyHessian(const std::vector<IslandBody*>& bodies, const st
 int PrimalSolver::SolveNewtonStep(const std::vector<IslandBody*>& bodies,
                                   const PrimalSettings& settings) {
   const size_t nb = bodies.size();
-  // Local rows only: H = N, one solve per body.
+  // Local rows only and fresh factors: H = N, one solve per body.
   for (size_t b = 0; b < nb; ++b) {
     d_[b] = -grad_[b];
     bodies[b]->SolveNewton(d_[b]);
   }
-  if (!coupled_) return 1;
-  // Coupled: PCG on H d = -grad from d = N^-1 (-grad), preconditioner N^-1.
+  if (!coupled_ && !any_stale_) return 1;
+  // Coupled or kept factors: PCG on H d = -grad from d = N^-1 (-grad), preconditioner N^-1 (a
+  // kept factor: to the looser stale tolerance, within the refactor budget).
+  const bool only_stale = any_stale_ && !coupled_;
+  const double tolerance = any_stale_ ? settings.stale_pcg_tolerance : settings.pcg_tolerance;
+  const int max_iterations =
+      only_stale ? std::max(1, static_cast<int>(stale_budget_)) : settings.max_pcg_iterations;
   ApplyHessian(bodies, d_, hp_);
   for (size_t b = 0; b < nb; ++b) r_[b] = -grad_[b] - hp_[b];
   const double rhs_norm = std::sqrt(Dot(grad_, grad_));
@@ -323,8 +343,8 @@ int PrimalSolver::SolveNewtonStep(const std::vector<IslandBody*>& bodies,
   }
   double rz = Dot(r_, z_);
   int it = 1;
-  for (; it <= settings.max_pcg_iterations; ++it) {
-    if (std::sqrt(Dot(r_, r_)) <= settings.pcg_tolerance * rhs_norm || rz <= 0.0) break;
+  for (; it <= max_iterations; ++it) {
+    if (std::sqrt(Dot(r_, r_)) <= tolerance * rhs_norm || rz <= 0.0) break;
     ApplyHessian(bodies, p_, hp_);
     const double php = Dot(p_, hp_);
     if (php <= 0.0) break;
@@ -340,6 +360,7 @@ int PrimalSolver::SolveNewtonStep(const std::vector<IslandBody*>& bodies,
     rz = rz_next;
     for (size_t b = 0; b < nb; ++b) p_[b] = z_[b] + beta * p_[b];
   }
+  if (any_stale_ && it > stale_budget_) refactor_next_ = true;
   return it;
 }
 
@@ -442,7 +463,7 @@ void PrimalSolver::CollectRowsAt(double h, const std::vector<IslandBody*>& bodie
                                  StepStats& stats) {
   const auto t = std::chrono::steady_clock::now();
   const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
-  stats.violation_after = rows_.Collect(h, bodies, sources, v, distance_scale);
+  violation_ = rows_.Collect(h, bodies, sources, v, distance_scale);
   rows_.WarmStart(iterate_, lambda_bar_);
   CalcPenalties(bodies, settings.primal);
   for (size_t b = 0; b < bodies.size(); ++b) v_[b] = v[b];
@@ -461,7 +482,8 @@ bool PrimalSolver::TakeNewtonStep(double h, const std::vector<IslandBody*>& bodi
   CalcGradient(bodies);
   if (primal.curvature) CollectCurvature(h, bodies, sources);
   else curvature_.clear();
-  AssembleNewtonMatrices(bodies);
+  ChooseFactorReuse(bodies, primal);
+  stats.newton_factorizations += AssembleNewtonMatrices(bodies);
   stats.pcg_iterations += SolveNewtonStep(bodies, primal);
   stats.newton_iterations++;
 
@@ -507,6 +529,34 @@ bool PrimalSolver::WarmStartVelocities(const std::vector<IslandBody*>& bodies) {
   return true;
 }
 
+void PrimalSolver::ChooseStartVelocities(double h, const std::vector<IslandBody*>& bodies,
+                                          const std::vector<ConstraintSource*>& sources,
+                                          const SqpSettings& settings, StepStats& stats) {
+  // Candidates in order: v*, v* + A^-1 J^T lambda_bar, the step-start velocity (v* on pinned
+  // blocks); the one of least Phi (with its rows) is the start. Rows are at v* on entry.
+  double best = CalcMerit(bodies, v_);
+  const auto try_candidate = [&] {
+    base_.Save(*this);
+    CollectRowsAt(h, bodies, sources, v_trial_, settings, stats);
+    const double phi = CalcMerit(bodies, v_);
+    if (phi < best) {
+      best = phi;
+    } else {
+      base_.Restore(*this);
+    }
+  };
+  if (WarmStartVelocities(bodies)) try_candidate();
+  bool moved = false;
+  for (size_t b = 0; b < bodies.size(); ++b) {
+    const IslandBody& body = *bodies[b];
+    v_trial_[b] = body.v_star();
+    for (int i = 0; i < body.num_blocks(); ++i)
+      if (body.is_free_block(i)) v_trial_[b].segment<3>(3 * i) = body.v_start().segment<3>(3 * i);
+    moved = moved || v_trial_[b] != body.v_star();
+  }
+  if (moved) try_candidate();
+}
+
 void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
                          const std::vector<ConstraintSource*>& sources,
                          const SqpSettings& settings, KeyedMultipliers& warm, StepStats& stats) {
@@ -520,10 +570,11 @@ void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
       (*list)[b].setZero(start[b].size());
   }
   iterate_ = settings.warm_start ? warm : KeyedMultipliers();
+  refactor_next_ = false;  // a factor kept from the previous step may precondition this one
   const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
   CollectRowsAt(h, bodies, sources, start, settings, stats);
-  stats.violation_before = stats.violation_after;
-  if (WarmStartVelocities(bodies)) CollectRowsAt(h, bodies, sources, v_trial_, settings, stats);
+  stats.violation_before = violation_;
+  ChooseStartVelocities(h, bodies, sources, settings, stats);
   for (int k = 0; !rows_.empty(); ++k) {
     // Certificate of (v, lambda_bar) at the rows of v.
     rows_.CountTypes(stats);
@@ -548,6 +599,7 @@ void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
   }
   if (rows_.empty()) iterate_.clear();
   for (size_t b = 0; b < nb; ++b) bodies[b]->set_v(v_[b]);
+  stats.violation_after = violation_;  // of the rows kept (a restored base point's, not a trial's)
   warm = iterate_;
   stats.islands_primal++;
 }

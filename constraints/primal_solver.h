@@ -1,4 +1,4 @@
-// The primal island solver (DESIGN.md "One step", stage 6, primal path): an augmented-Lagrangian
+// The primal island solver (docs/math.md §5.8): an augmented-Lagrangian
 // SQP on the island's velocities, each linearized problem minimized by Newton's method with an
 // exact line search, the multipliers updated by projection. Used where the papers' dual PGS
 // cannot converge: more limit rows than free DOFs make W = J A^-1 J^T rank-deficient, while the
@@ -44,6 +44,11 @@ class PrimalSolver {
   void CollectRowsAt(double h, const std::vector<IslandBody*>& bodies,
                      const std::vector<ConstraintSource*>& sources, const std::vector<VecX>& v,
                      const SqpSettings& settings, StepStats& stats);
+  // Stage: the start of the Newton iterations, the candidate velocity of least Phi (v*, the warm
+  // start below, the step-start velocity); leaves its rows collected.
+  void ChooseStartVelocities(double h, const std::vector<IslandBody*>& bodies,
+                             const std::vector<ConstraintSource*>& sources,
+                             const SqpSettings& settings, StepStats& stats);
   // v = v* + A^-1 J^T lambda_bar into v_trial_ (false when there is no warm multiplier).
   bool WarmStartVelocities(const std::vector<IslandBody*>& bodies);
   // rho_c of every row from the diagonal Delassus estimate (friction rows: their normal's).
@@ -63,8 +68,11 @@ class PrimalSolver {
   void CalcProjectedMultipliers();
   // grad = A(v - v*) - J^T lambda on free blocks.
   void CalcGradient(const std::vector<IslandBody*>& bodies);
-  // N_b = A_b + G_b + sum rho D J^T J (same-body blocks of rows held on the pattern), factored.
-  void AssembleNewtonMatrices(const std::vector<IslandBody*>& bodies);
+  // Stage: which bodies keep their last factor as the preconditioner (stale_), by its cost.
+  void ChooseFactorReuse(const std::vector<IslandBody*>& bodies, const PrimalSettings& settings);
+  // N_b = A_b + G_b + sum rho D J^T J (same-body blocks of rows held on the pattern), factored
+  // for the bodies that do not keep their factor. Returns the number of factorizations.
+  int AssembleNewtonMatrices(const std::vector<IslandBody*>& bodies);
   // d = -H^-1 grad: one solve per body when H = N, else PCG with N as preconditioner. Returns the
   // PCG iterations (1 for the direct solve).
   int SolveNewtonStep(const std::vector<IslandBody*>& bodies, const PrimalSettings& settings);
@@ -92,6 +100,11 @@ class PrimalSolver {
   std::vector<Eigen::Matrix2d> d_disk_;  // D of a friction pair, on its first tangent row
   std::vector<char> in_pattern_;         // row's same-body blocks fit the patterns
   bool coupled_ = false;                 // some row is two-sided or off-pattern: PCG
+  std::vector<char> stale_;              // body keeps its last factor (ChooseFactorReuse)
+  bool any_stale_ = false;
+  double stale_budget_ = 0.0;            // CG iterations a kept factor may take before a refactor
+  bool refactor_next_ = false;           // the last kept factor took too many: refactor
+  double violation_ = 0.0;               // largest row violation at the collected rows
   struct CurvatureBlock {
     int body, a, b;
     Mat3 block;
@@ -119,6 +132,7 @@ class PrimalSolver {
     VecX lambda_bar, rho, g0;
     std::vector<char> in_pattern;
     bool coupled = false;
+    double violation = 0.0;
     std::vector<VecX> v;
     void Save(const PrimalSolver& s) {
       rows = s.rows_;
@@ -127,6 +141,7 @@ class PrimalSolver {
       g0 = s.g0_;
       in_pattern = s.in_pattern_;
       coupled = s.coupled_;
+      violation = s.violation_;
       v = s.v_;
     }
     void Restore(PrimalSolver& s) const {
@@ -136,6 +151,7 @@ class PrimalSolver {
       s.g0_ = g0;
       s.in_pattern_ = in_pattern;
       s.coupled_ = coupled;
+      s.violation_ = violation;
       s.v_ = v;
       s.jv_.resize(s.rows_.size());
       s.s_.setZero(s.rows_.size());

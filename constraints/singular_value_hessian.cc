@@ -7,7 +7,7 @@ namespace {
 
 constexpr double kInvSqrt2 = 0.70710678118654752440;
 
-// d with |d| raised to at least rho, keeping its sign (sgn(0) := +1; MATH.md §2 R1).
+// d with |d| raised to at least rho, keeping its sign (sgn(0) := +1; docs/math.md §2 R1).
 double ClampGap(double d, double rho) {
   if (std::abs(d) >= rho) return d;
   return d >= 0.0 ? rho : -rho;

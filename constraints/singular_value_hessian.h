@@ -1,19 +1,19 @@
 // Second derivative of one signed singular value of a 3x3 matrix, as an eigen-decomposition, and
 // its map to the node space of a tet (the curvature of strain-limit rows, issue 11 item 3).
 //
-// With the signed SVD F = U diag(s) V^T (MATH.md §0) and P = U^T dF V, the second-order change
-// of s_i is (checked against FD in tests/singular_value_hessian_test.cc)
+// With the signed SVD F = U diag(s) V^T (docs/math.md §0.2) and P = U^T dF V, the second-order
+// change of s_i is (checked against FD in tests/singular_value_hessian_test.cc)
 //   d^2 s_i[dF, dF] = sum_{j != i} [ a_j^2 / (s_i - s_j) + b_j^2 / (s_i + s_j) ],
 //   a_j = (P_ij + P_ji)/sqrt2 = <dF, S_j>,  S_j = (u_i v_j^T + u_j v_i^T)/sqrt2   (symmetric mode)
 //   b_j = (P_ij - P_ji)/sqrt2 = <dF, A_j>,  A_j = (u_i v_j^T - u_j v_i^T)/sqrt2   (antisymmetric)
 // and 0 on the other five directions (the diagonal modes u_k v_k^T and the (j, k) pair modes).
 // The four modes are Frobenius-orthonormal, so the Hessian's eigenvalues are exactly
 // 1/(s_i - s_j) and 1/(s_i + s_j). Both blow up at repeated values (s_i = s_j) or, for an
-// inverted tet, at s_i = -s_j; the gap clamp of MATH.md §2 R1 bounds them: |s_i -+ s_j| >= rho
+// inverted tet, at s_i = -s_j; the gap clamp of docs/math.md §2 R1 bounds them: |s_i -+ s_j| >= rho
 // with rho = epsilon / (|s_i| + |s_j|), i.e. |s_i^2 - s_j^2| >= epsilon.
 //
-// Tet node space (MATH.md §0): F = sum_n x_n r_n^T, so <dF, M> = sum_n dx_n . (M r_n) and each
-// mode contributes lambda (M r_a)(M r_b)^T to the 3x3 block of nodes (a, b).
+// Tet node space (docs/math.md §0.1): F = sum_n x_n r_n^T, so <dF, M> = sum_n dx_n . (M r_n) and
+// each mode contributes lambda (M r_a)(M r_b)^T to the 3x3 block of nodes (a, b).
 #pragma once
 
 #include <array>

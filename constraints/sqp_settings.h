@@ -25,6 +25,13 @@ struct PrimalSettings {
   int max_pcg_iterations = 200;     // coupled islands: PCG on the Newton step
   double pcg_tolerance = 1e-10;     // relative residual of that PCG
   bool curvature = true;            // lagged row curvature G in the model and H
+  // Factor reuse: a body whose H costs more than min_refactor_cost preconditioned CG iterations
+  // to factor keeps its last factor (from an earlier Newton iteration or step) as the
+  // preconditioner of CG on the exact H, to stale_pcg_tolerance, while CG needs fewer than half
+  // that cost; then it refactors.
+  bool reuse_factorization = true;
+  double min_refactor_cost = 8.0;
+  double stale_pcg_tolerance = 1e-6;
 };
 
 // PGS settings of the QPs: 100 sweeps at most.
@@ -41,7 +48,7 @@ struct SqpSettings {
   double violation_tolerance = 1e-3; // stop when max(0, -C) <= this (C is a fraction of the limit)
   double contact_tolerance = 1e-5;   // [m] the same for contact and joint rows, whose C is a
                                      // distance (rigid contacts: h times a velocity error)
-  double stationarity_tolerance = 1e-2;  // ... and ||A(v - v*) - J^T lambda|| / ||J^T lambda||
+  double stationarity_tolerance = 1e-2;  // ... and the relative stationarity (kkt_certificate.h)
   int max_restoration_iterations = 10;  // push-only iterations after the cap while infeasible
   int max_line_search_halvings = 8;  // merit backtracking: alpha = 1, 1/2, ...
   double stalled_step = 0.1;         // feasible and last alpha below this: stop (stalled)

@@ -157,8 +157,8 @@ void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
       break;
     }
     if (k >= settings.max_iterations) {
-      // SQP cap reached while infeasible: push-only restoration steps (MATH.md §5 "incremental
-      // dlambda >= 0": feasible in a few iterations, at the price of stationarity).
+      // SQP cap reached while infeasible: push-only restoration steps (docs/math.md §5.7,
+      // "incremental dlambda >= 0": feasible in a few iterations, at the price of stationarity).
       if (feasible || k >= settings.max_iterations + settings.max_restoration_iterations) break;
       restoring = true;
     }

@@ -1,5 +1,5 @@
 // The constrained step: SQP outer loop with the total multiplier, each QP solved by one PGS
-// (MATH.md §5). Shared by every row type.
+// (docs/math.md §5.7). Shared by every row type.
 #pragma once
 
 #include <vector>

@@ -3,7 +3,7 @@
 
 namespace taut {
 
-// What one world substep did and how long each stage took (DESIGN.md "One step", stage 8).
+// What one world substep did and how long each stage took (docs/architecture.md §3, stage 8).
 struct StepStats {
   // Time per stage [ms].
   double ms_unconstrained = 0.0;  // assemble forces and A, factor, solve v*
@@ -12,6 +12,19 @@ struct StepStats {
   double ms_integrate = 0.0;      // x = x0 + h v
   double ms_rigid = 0.0;          // Bullet's own rigid step
   double ms_total = 0.0;
+
+  // Time per stage of DeformableWorld's substep [ms], docs/architecture.md §3 stage number first.
+  // Measured one after the other inside ms_total; the rest of ms_total is Bullet's own (rigid
+  // prediction, collision detection, integration of the rigid transforms).
+  double ms_stage_begin_steps = 0.0;    // 2: unconstrained deformable step (= ms_unconstrained)
+  double ms_stage_partners = 0.0;       // 3: swept bounds, rigid partners, deformable pairs
+  double ms_stage_islands = 0.0;        // 4: union-find islands
+  double ms_stage_couple_rigid = 0.0;   // 4: rigid bodies of deformable islands begin their step
+  double ms_stage_row_sources = 0.0;    // 5: row sources, Bullet manifolds and joints per island
+  double ms_stage_bullet_solver = 0.0;  // 6: Bullet's solver for the rigid-only islands
+  double ms_stage_solve_islands = 0.0;  // 6: one SQP per deformable island (rows and solve)
+  double ms_stage_end_steps = 0.0;      // 7: x = x0 + h v (= ms_integrate)
+
   // Constraint work.
   int rows_strain = 0;            // active strain-limit rows (last SQP iteration)
   int rows_energy = 0;            // active energy-limit rows
@@ -26,9 +39,9 @@ struct StepStats {
   // and of contact/joint rows (C in m) times violation_tolerance / contact_tolerance.
   double violation_before = 0.0;  // at the unconstrained prediction x*
   double violation_after = 0.0;   // at the end of the step
-  double stationarity = 0.0;      // ||A(v - v*) - J^T lambda|| / ||J^T lambda|| at the end
+  double stationarity = 0.0;      // relative ||A(v - v*) - J^T lambda|| at the end (kkt_certificate.h)
   // Natural-map residual ||lambda - Proj_K(lambda - w)||_inf of the last QP at exit (PGS, after
-  // any projected-Newton polish; MATH.md §5) [units of lambda and w].
+  // any projected-Newton polish; docs/math.md §5.7) [units of lambda and w].
   double lcp_residual = 0.0;
   bool converged = true;          // every KKT residual below within tolerance at the end
 
@@ -38,6 +51,8 @@ struct StepStats {
   int islands_primal = 0;
   int newton_iterations = 0;      // primal path: Newton iterations over all SQP iterations
   int pcg_iterations = 0;         // primal path: PCG iterations (1 per Newton step when local)
+  int newton_factorizations = 0;  // primal path: Newton matrices factored (fewer than Newton
+                                  // iterations when bodies keep their factor, PrimalSettings)
   // Convergence certificate at the end of the step (constraints/kkt_certificate.h), worst island:
   double kkt_primal = 0.0;           // max(0, -C) of every row (distance rows scaled), C units
   double kkt_complementarity = 0.0;  // |C| of pushing rows, slip of sticking contacts, C units

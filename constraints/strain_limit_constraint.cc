@@ -85,22 +85,31 @@ int StrainLimitConstraint::AppendRows(const VecX& x, int body_index,
 void StrainLimitConstraint::AddIslandCurvature(const IslandIterate& iterate,
                                                const ConstraintRow* rows, const double* weights,
                                                int count, CurvatureSink& sink) const {
-  int element = -1;  // rows of one element are adjacent: one SVD per element
+  // Rows of one element are adjacent: one SVD per element, and sum_c w_c H_c of its rows is
+  // scattered once (16 node blocks per element, not per row).
+  int element = -1, body = -1;
   SignedSvd svd;
+  Mat12 sum = Mat12::Zero();
+  const auto flush = [&] {
+    if (element >= 0) AddElementCurvatureBlocks<4>(sum, 1.0, body, tets_.element_nodes(element), sink);
+  };
   for (int c = 0; c < count; ++c) {
     const ConstraintRow& row = rows[c];
     if (RowKeySource(row.key) != source_id_ || !(weights[c] > 0.0)) continue;
     const StrainLimitKey key = StrainLimitKey::Unpack(RowKeyPayload(row.key));
     const TetRestRows& r = tets_.rest().elements[key.element].r;
-    if (key.element != element) {
+    if (key.element != element || row.body != body) {
+      flush();
       element = key.element;
+      body = row.body;
+      sum.setZero();
       svd = CalcSignedSvd(
           CalcTetDeformationGradient(r, tets_.GatherElement(iterate.x(row.body), element)));
     }
-    const Mat12 H = CalcStrainLimitRowCurvature(r, svd, SelectStrainLimitFrame(settings_, element),
-                                                params_, key);
-    AddElementCurvatureBlocks<4>(H, weights[c], row.body, tets_.element_nodes(element), sink);
+    sum.noalias() += weights[c] * CalcStrainLimitRowCurvature(
+                                      r, svd, SelectStrainLimitFrame(settings_, element), params_, key);
   }
+  flush();
 }
 
 double StrainLimitConstraint::CalcElementViolation(const VecX& x, int e) const {

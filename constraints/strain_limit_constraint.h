@@ -1,4 +1,4 @@
-// Strain limits of one tet body as a source of SQP rows (paper A; MATH.md §2-§3).
+// Strain limits of one tet body as a source of SQP rows (paper A; docs/math.md §2-§3).
 #pragma once
 
 #include <array>

@@ -25,7 +25,7 @@ double CalcStrainRowStretchSlope(const Mat3& V_prime, int i, const StrainLimitPa
       return 1.0 / std::abs(s_cap.cwiseProduct(w).norm() - 1.0);
     }
     case StrainProjection::kEllipsoid:
-      // C = 1 - |s_i - 1| ||K w|| (MATH.md §3).
+      // C = 1 - |s_i - 1| ||K w|| (docs/math.md §3.5).
       return (is_max ? params.kappa_max : params.kappa_min).cwiseProduct(w).norm();
   }
   return 0.0;

@@ -1,11 +1,11 @@
 // Curvature of one strain-limit row for the SQP metric: the lagged geometric stiffness
-// h lambda [-d^2 C/dx^2]_+ (issue 11 item 3; SOLVER_ANCHORS R2).
+// h lambda [-d^2 C/dx^2]_+ (issue 11 item 3; docs/math.md §5.9).
 //
 // Every row of constraints/strain_limit_rows.h is, with its frame factor frozen,
 //   C_max = 1 - kappa_eff (s_i - 1),   C_min = 1 + kappa_eff (s_i - 1),   kappa_eff = |dC/ds_i|,
 //   hyperbolic (j, i): kappa^j |V'_ji|      ellipsoid (i): ||K V' e_i||
 //   linear interp (i): 1 / |L - 1|          orthogonal (j, i): 1 / |d^j|
-// (MATH.md §3). The metric keeps the dominant term, the one through s_i:
+// (docs/math.md §3). The metric keeps the dominant term, the one through s_i:
 //   -d^2 C/dx^2 ~ +kappa_eff d^2 s_i/dx^2 (upper bound),  -kappa_eff d^2 s_i/dx^2 (lower bound),
 // dropping the |V'_ji| curvature (a lagged Gauss-Newton-like approximation: it only changes the
 // metric, not the converged step), and clamps negative modes so the block is positive

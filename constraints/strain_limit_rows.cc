@@ -10,7 +10,7 @@ namespace {
 constexpr std::array<std::array<int, 3>, 6> kPermutations = {
     {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}}};
 
-// sgn with sgn(0) := 0 (MATH.md §2 R2).
+// sgn with sgn(0) := 0 (docs/math.md §2 R2).
 double Sign(double v) { return v > 0.0 ? 1.0 : (v < 0.0 ? -1.0 : 0.0); }
 
 // True when all three entries are equal (then ||diag(a) w|| = a for unit w: dV/dx drops out).
@@ -64,7 +64,7 @@ class RowEvaluator {
   }
 
   // Hyperbolic (eqs. 11-12, 17-18) or orthogonal (eqs. 19-20) rows (j, i), j = 0..2. Hyperbolic
-  // rows are filtered: only those with C_j <= min_j C_j + band (SOLVER_ANCHORS R3); every C_j
+  // rows are filtered: only those with C_j <= min_j C_j + band (docs/math.md §3.7); every C_j
   // still counts for min C, so violations and the feasible set do not change.
   void EvaluatePerAxis(int i, StrainBound bound) {
     const bool hyperbolic = params_.projection == StrainProjection::kHyperbolic;
@@ -138,7 +138,7 @@ class RowEvaluator {
     Emit(i, -1, bound, C, J);
   }
 
-  // Ellipsoid (MATH.md §3): n = ||K w||, C = 1 - |s_i - 1| n.
+  // Ellipsoid (docs/math.md §3.5): n = ||K w||, C = 1 - |s_i - 1| n.
   void EvaluateEllipsoid(int i, StrainBound bound) {
     const bool is_max = bound == StrainBound::kMax;
     const double sigma = is_max ? 1.0 : -1.0;

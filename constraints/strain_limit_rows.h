@@ -1,5 +1,5 @@
 // Strain-limit constraint rows of one tet: C(x) >= 0 and its exact Jacobian dC/dx (paper A
-// eqs. 11-18 and 19-22; MATH.md §2-§3).
+// eqs. 11-18 and 19-22; docs/math.md §2-§3).
 //
 // With the signed SVD G = U diag(s) V^T, the limit frame Q and V' = Q^T V (w = V' e_i, so
 // w_j = V'_ji), every row is scaled to C = 1 - |s_i - 1| / d_eff: C = 1 at rest, 0 at the limit,
@@ -11,8 +11,8 @@
 //                      d_eff = d^j |V'_ji| vanishes on orthogonal pairs, so it cannot divide)
 // with kappa^j, d^j from the bound's side (max: s_i > 1, min: s_i < 1). OP and LI use the capped
 // deviations of StrainLimitParams. Only rows with C < tau are emitted, C_max only where s_i > 1
-// and C_min only where s_i < 1 (MATH.md §2 R2); the others hold with margin. sgn(0) := 0 at the
-// |V'_ji| kink, which lies strictly inside the feasible set for the hyperbolic rows (R2).
+// and C_min only where s_i < 1 (docs/math.md §2 R2); the others hold with margin. sgn(0) := 0 at
+// the |V'_ji| kink, which lies strictly inside the feasible set for the hyperbolic rows (R2).
 #pragma once
 
 #include <array>
@@ -29,8 +29,8 @@ namespace taut {
 enum class StrainBound : std::uint8_t { kMin = 0, kMax = 1 };
 
 // Identity of a strain-limit row for warm starts, stable when singular values swap order
-// (MATH.md §2 R3): it never uses the principal index i. Instead principal direction v_i is named
-// by the material axis it is matched to, m = pi(i), where pi is the permutation maximising
+// (docs/math.md §2 R3): it never uses the principal index i. Instead principal direction v_i is
+// named by the material axis it is matched to, m = pi(i), where pi is the permutation maximising
 // sum_i |V'_{pi(i) i}| (each principal direction to its nearest limit axis, one to one).
 struct StrainLimitKey {
   int element = -1;

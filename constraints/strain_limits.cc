@@ -19,7 +19,7 @@ void DemandRotation(const Mat3& Q, const std::string& what, const std::string& w
               "); its columns must be orthonormal limit axes with det Q = +1");
 }
 
-// 1/|s - 1| for a limited axis, 0 for an unlimited one (MATH.md §3 kappa form).
+// 1/|s - 1| for a limited axis, 0 for an unlimited one (docs/math.md §3.1).
 double CalcKappa(double s, bool limited) { return limited ? 1.0 / std::abs(s - 1.0) : 0.0; }
 
 // True when the non-zero (limited) entries of kappa are all equal. Exact comparison: equal
@@ -35,8 +35,8 @@ bool HasEqualLimitedEntries(const Vec3& kappa) {
 }
 
 // The rows evaluated for the settings: hyperbolic with equal limits on every limited axis of
-// both bounds becomes the ellipsoid rule (MATH.md §3: identical for one limited axis,
-// isotropy-consistent for more; SOLVER_ANCHORS R3).
+// both bounds becomes the ellipsoid rule (docs/math.md §3.7: identical for one limited
+// axis, isotropy-consistent for more).
 StrainProjection SelectEvaluatedProjection(const StrainLimitSettings& settings,
                                            const StrainLimitParams& params) {
   const bool equal =

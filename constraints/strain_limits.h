@@ -1,4 +1,4 @@
-// User-facing strain-limit settings of a tet body (paper A §3; MATH.md §2-§3) and their
+// User-facing strain-limit settings of a tet body (paper A §3; docs/math.md §2-§3) and their
 // compiled, validated form used by the row evaluation (constraints/strain_limit_rows.h).
 //
 // Limits are given per material limit axis j = 0, 1, 2 as stretch ratios: s_min[j] <= s <= s_max[j]
@@ -6,7 +6,7 @@
 // StrainProjection. The limit axes are the columns q_j of a rotation Q in rest coordinates (the
 // body frame, or one frame per element for fibre directions); with Q = I they are the world axes
 // of the rest mesh. Internally the limits become kappa^j = 1/|s^j - 1| (kappa = 0: unlimited,
-// MATH.md §3), so no infinity reaches a formula.
+// docs/math.md §3.1), so no infinity reaches a formula.
 #pragma once
 
 #include <limits>
@@ -20,9 +20,10 @@ namespace taut {
 // How axis limits become limits along the principal directions v_i (V' = Q^T V, w = V' e_i).
 enum class StrainProjection {
   kHyperbolic,           // paper A eqs. 7-8: s^{j,i} = 1 + d^j / |V'_ji|; 18 rows per tet.
-  kOrthogonal,           // paper A eqs. 19-20: s^{j,i} = 1 + d^j |V'_ji|; freezes (MATH.md §6 A1).
+  kOrthogonal,           // paper A eqs. 19-20: s^{j,i} = 1 + d^j |V'_ji|; freezes
+                         // (docs/math.md §6 A1).
   kLinearInterpolation,  // paper A eqs. 21-22: s^i = ||diag(s^j) w||; 6 rows; needs caps.
-  kEllipsoid,            // MATH.md §3 2-norm variant: d^i = 1 / ||K w||; isotropy-consistent.
+  kEllipsoid,            // docs/math.md §3.5 (2-norm): d^i = 1 / ||K w||; isotropy-consistent.
                          // With equal limits on all axes this is paper A's isotropic limit
                          // (eqs. 9-10): s_min <= s_i <= s_max for every i, in any frame.
 };
@@ -44,11 +45,11 @@ struct StrainLimitSettings {
   // (Isotropic() defaults to kEllipsoid, paper A's isotropic limit).
   StrainProjection projection = StrainProjection::kHyperbolic;
   // kHyperbolic only: when each bound's limits are equal on all of its limited axes, evaluate
-  // the ellipsoid rows instead (MATH.md §3, R3): one row per principal axis and bound,
+  // the ellipsoid rows instead (docs/math.md §3.7): one row per principal axis and bound,
   // C = 1 - kappa |s_i - 1| ||P_L V' e_i|| (P_L: the limited axes). Identical to the hyperbolic
   // rows for one limited axis; for two or three equal axes it is the isotropy-consistent limit
   // (exactly d in every direction of the limited subspace) where the hyperbolic rule allows up
-  // to sqrt(2) d or sqrt(3) d (MATH.md §6 A3). false: paper A's rows. Default true.
+  // to sqrt(2) d or sqrt(3) d (docs/math.md §6 A3). false: paper A's rows. Default true.
   bool equal_limits_use_ellipsoid = true;
   // kHyperbolic only, >= 0 (may be +inf): per (principal axis i, bound) emit only the dominant
   // row (smallest C over the axes j) and the rows with C_j < C_min + band. The others satisfy
@@ -61,15 +62,15 @@ struct StrainLimitSettings {
   // replace `frame`. Default: empty.
   std::vector<Mat3> element_frames;
   // kOrthogonal / kLinearInterpolation only: s used for an unlimited compress axis, in [0, 1).
-  // Default 0 (d = -1, MATH.md §3). Results of these modes depend on the caps.
+  // Default 0 (d = -1, docs/math.md §3.1). Results of these modes depend on the caps.
   double unlimited_s_min_cap = 0.0;
   // kOrthogonal / kLinearInterpolation only: s used for an unlimited stretch axis, finite, > 1.
-  // Default 2 (d = 1, MATH.md §3).
+  // Default 2 (d = 1, docs/math.md §3.1).
   double unlimited_s_max_cap = 2.0;
   // Activation margin tau >= 0 (may be +inf): emit rows with C < tau. C is the remaining fraction
   // of the limit (1 at rest, 0 at the limit), so tau = 0.2 emits rows past 80 % of their limit.
   double activation_margin = kDefaultStrainActivationMargin;
-  // Gap clamp epsilon of MATH.md §2 R1 [s^2 units], >= 0, finite. Default 1e-2.
+  // Gap clamp epsilon of docs/math.md §2 R1 [s^2 units], >= 0, finite. Default 1e-2.
   double svd_gap_epsilon = 1e-2;
   // Use the frozen-frame Jacobian (dV/dx = 0), for comparison with the exact one. Default false.
   bool freeze_frame_jacobian = false;
@@ -92,7 +93,7 @@ struct StrainLimitSettings {
   void Validate(int num_elements, const std::string& where) const;
 };
 
-// Compiled limits of one body, as used by the row evaluation (MATH.md §3).
+// Compiled limits of one body, as used by the row evaluation (docs/math.md §3).
 struct StrainLimitParams {
   // The rows evaluated: settings.projection, or kEllipsoid for kHyperbolic with equal limits
   // (StrainLimitSettings::equal_limits_use_ellipsoid).
@@ -109,7 +110,7 @@ struct StrainLimitParams {
   double hyperbolic_row_band = kDefaultHyperbolicRowBand;     // emit C_j <= C_min + band
 };
 
-// Converts validated settings into kappa and capped deviations (MATH.md §3), and picks the
+// Converts validated settings into kappa and capped deviations (docs/math.md §3), and picks the
 // evaluated projection (equal hyperbolic limits -> ellipsoid).
 StrainLimitParams CalcStrainLimitParams(const StrainLimitSettings& settings);
 

@@ -45,7 +45,7 @@ Mat3x12 CalcSingularVectorGradient(const SignedSvd& svd, const TetRestRows& r, i
     auto block = grad.block<3, 3>(0, 3 * n);
     for (int m = 0; m < 3; ++m) {
       if (m == i) continue;
-      // MATH.md §2: v_m [s_m (r_n.v_i) u_m^T + s_i (r_n.v_m) u_i^T] / D_im.
+      // docs/math.md §2.2: v_m [s_m (r_n.v_i) u_m^T + s_i (r_n.v_m) u_i^T] / D_im.
       const double inv_D = 1.0 / CalcClampedGapDenominator(s, i, m, gap_epsilon);
       const Vec3 row = (s[m] * a[i] * inv_D) * U.col(m) + (s[i] * a[m] * inv_D) * U.col(i);
       block.noalias() += V.col(m) * row.transpose();
@@ -62,7 +62,7 @@ SvdDifferential CalcSvdDifferential(const SignedSvd& svd, const Mat3& dG, double
   for (int i = 0; i < 3; ++i) {
     for (int m = 0; m < 3; ++m) {
       if (m == i) continue;
-      // PL 2x2 solve (MATH.md §2) with a = m, b = i.
+      // PL 2x2 solve (docs/math.md §2.1) with a = m, b = i.
       const double D = CalcClampedGapDenominator(s, i, m, gap_epsilon);
       omega_V(m, i) = (s[m] * P(m, i) + s[i] * P(i, m)) / D;
       omega_U(m, i) = (s[i] * P(m, i) + s[m] * P(i, m)) / D;

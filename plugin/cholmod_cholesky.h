@@ -24,7 +24,7 @@ struct CholmodStateDeleter {
 
 // Sparse P A P^T = L L^T of a symmetric positive definite A (L lower triangular with a positive
 // diagonal, P a fill-reducing permutation), for A = M + h D + h^2 K of the implicit step
-// (DESIGN.md step 2, MATH.md §5) of bodies too large for SparseLdlt.
+// (docs/math.md §5.1) of bodies too large for SparseLdlt.
 //
 // Algorithm: CHOLMOD's supernodal left-looking Cholesky (Y. Chen, T. A. Davis, W. W. Hager,
 // S. Rajamanickam, "Algorithm 887: CHOLMOD, supernodal sparse Cholesky factorization and

@@ -1,5 +1,5 @@
 // Co-rotational linear elasticity on one trilinear hexahedron (paper B with the fixes of
-// MATH.md §4 and §6 B1-B3).
+// docs/math.md §4 and §6 B1-B3).
 //
 // With h_qa = (H(s_q) F_q^-1)_a the gradient of N_a w.r.t. the rest coordinates at Gauss point q
 // (F_q = dX/ds there, 2x2x2 rule, weights 1) and u = R^T x - X (24), the element energy is
@@ -23,7 +23,7 @@ using Mat24 = Eigen::Matrix<double, 24, 24>;
 using HexNodes = std::array<Vec3, 8>;
 using HexGradients = Eigen::Matrix<double, 8, 3>;  // row a = gradient of N_a [1/m]
 
-// How the element rotation is taken (MATH.md §4).
+// How the element rotation is taken (docs/math.md §4.4).
 enum class HexRotationMethod {
   kCenterPolar,   // R = polar(G(0)): no spurious rotation under bending modes (recommended)
   kInscribedTet,  // R = polar(G_{1467}) of the inscribed tet (paper B; aliases bending)

@@ -1,7 +1,7 @@
 // Co-rotational linear elasticity on one linear tetrahedron.
 //
 // With R the rotation of the signed polar decomposition G = R S (S = R^T G symmetric, also for
-// inverted elements: MATH.md §0), the strain is eps = S - I and the energy
+// inverted elements: docs/math.md §0.2), the strain is eps = S - I and the energy
 //   Psi = V [ mu ||S - I||_F^2 + (lambda/2) tr(S - I)^2 ]                       [J]
 // Its first Piola stress is P = 2 mu (G - R) + lambda tr(S - I) R, exact because the dR terms
 // vanish (S - I symmetric, R^T dR skew). Nodal forces f_n = -V P r_n equal -dPsi/dx_n, i.e. the

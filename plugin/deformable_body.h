@@ -1,4 +1,4 @@
-// A deformable FEM body: runtime state and the linearized backward-Euler step (MATH.md §5).
+// A deformable FEM body: runtime state and the linearized backward-Euler step (docs/math.md §5.1).
 #pragma once
 
 #include <functional>
@@ -36,6 +36,7 @@ class DeformableBody {
   const VecX& v() const { return v_; }
   const VecX& x0() const { return x0_; }          // positions at the step start
   const VecX& v_star() const { return v_star_; }  // unconstrained velocity of this step
+  const VecX& v0() const { return v0_; }          // velocity at the step start
   const VecX& mass() const { return mass_; }      // lumped mass per node [kg]
   NodeKind node_kind(int i) const { return kinds_[i]; }
   Vec3 node_position(int i) const { return x_.segment<3>(3 * i); }

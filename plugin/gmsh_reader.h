@@ -18,9 +18,9 @@ namespace taut {
 //   writes an element once per physical group) is kept once. No type-4 element is an error, which
 //   names the element types that were found (10-node tets, type 11, are not supported).
 // - Other sections ($Entities, $PhysicalNames, $NodeData, ...) are skipped.
-// Gmsh orders tet nodes with det[X2-X1, X3-X1, X4-X1] > 0, the opposite of MATH.md §0, so most
-// tets get nodes 0 and 1 swapped (internal::OrientAndValidateTetMesh); the mesh is then validated.
-// mesh.source is path. Throws MeshFileError ("file:line: reason") on any parse error.
+// Gmsh orders tet nodes with det[X2-X1, X3-X1, X4-X1] > 0, the opposite of docs/math.md §0.1, so
+// most tets get nodes 0 and 1 swapped (internal::OrientAndValidateTetMesh); the mesh is then
+// validated. mesh.source is path. Throws MeshFileError ("file:line: reason") on any parse error.
 TetMesh ReadGmshMesh(const std::string& path);
 
 namespace internal {

@@ -54,7 +54,7 @@ void ValidateHexLattice(const HexLattice& lattice) {
       const double det = CalcHexJacobian(X, HexGaussPoint(q)).determinant();
       TAUT_DEMAND(det > scale, src, ": element ", e, " is ", det < 0.0 ? "inverted" : "degenerate",
                   " (det dX/ds = ", det, " m^3 at Gauss point ", q,
-                  "; expected > 0 with the node order of MATH.md §4)");
+                  "; expected > 0 with the node order of docs/math.md §4.1)");
     }
   }
 }

@@ -9,7 +9,7 @@
 
 namespace taut {
 
-// Immutable rest geometry of a hex body. Local node order (MATH.md §4): paper node
+// Immutable rest geometry of a hex body. Local node order (docs/math.md §4.1): paper node
 // n = 4(i-1) + 2(j-1) + k (i, j, k in {1, 2}) with s_n = ((-1)^i, (-1)^j, (-1)^k) is local index
 // a = n - 1 = 4 bi + 2 bj + bk with bits bi = i - 1 etc., so node a sits at reference corner
 // s_a = (2 bi - 1, 2 bj - 1, 2 bk - 1): a = 0 is (-,-,-), a = 1 is (-,-,+), a = 2 is (-,+,-),

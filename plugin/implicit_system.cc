@@ -184,4 +184,14 @@ void ImplicitSystem::SolveNewton(Eigen::Ref<VecX> rhs) const {
 
 void ImplicitSystem::MultiplyNewton(const VecX& v, VecX& out) const { MultiplyWith(H_, v, out); }
 
+bool ImplicitSystem::HasNewtonFactor() const {
+  return newton_analyzed_ && num_free_dofs() > 0 && !use_cholmod_ && newton_ldlt_.factorized();
+}
+
+double ImplicitSystem::CalcNewtonRefactorCost() const {
+  if (!HasNewtonFactor()) return 0.0;
+  const double iteration = 4.0 * newton_ldlt_.nonzeros_in_L() + 2.0 * A_.nonZeros();
+  return newton_ldlt_.CalcFactorWork() / iteration;
+}
+
 }  // namespace taut

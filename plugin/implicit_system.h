@@ -79,6 +79,12 @@ class ImplicitSystem {
   void SolveNewton(Eigen::Ref<VecX> rhs) const;
   // out (3N) = H v on free DOFs, 0 on constrained DOFs.
   void MultiplyNewton(const VecX& v, VecX& out) const;
+  // True when a factor of some earlier H (this pattern) is held: usable as a preconditioner.
+  bool HasNewtonFactor() const;
+  // Cost of factoring H in units of one preconditioned CG iteration with the held factor (two
+  // triangular solves, 4 nnz(L), plus the product with A, 2 nnz(A)); 0 with CHOLMOD (its factor
+  // is not reused) or before the first factor.
+  double CalcNewtonRefactorCost() const;
 
  private:
   std::vector<int> dof_to_free_;   // (3N) free index or -1

@@ -17,13 +17,13 @@ std::string ReadMeshFileText(const std::string& path);
 // Quotes a token for an error message: at most 32 bytes, non-printable bytes as \xNN.
 std::string QuoteToken(std::string_view token);
 
-// Swaps nodes 0 and 1 of every tet whose signed volume det[X1-X4, X2-X4, X3-X4] / 6 (MATH.md §0)
-// is negative, then runs ValidateTetMesh. Gmsh and VTK store tets with the opposite convention
-// (det[X2-X1, X3-X1, X4-X1] > 0, which is det[X1-X4, X2-X4, X3-X4] < 0), and hand-made or
-// converted files mix both, so the readers rely on no file convention and normalise every tet this
-// way. Swapping two nodes is an odd permutation, so it flips the sign and keeps the node set.
-// Degenerate tets are left as they are and rejected by the validation. Returns the number of tets
-// that were flipped.
+// Swaps nodes 0 and 1 of every tet whose signed volume det[X1-X4, X2-X4, X3-X4] / 6
+// (docs/math.md §0.1) is negative, then runs ValidateTetMesh. Gmsh and VTK store tets with the
+// opposite convention (det[X2-X1, X3-X1, X4-X1] > 0, which is det[X1-X4, X2-X4, X3-X4] < 0), and
+// hand-made or converted files mix both, so the readers rely on no file convention and normalise
+// every tet this way. Swapping two nodes is an odd permutation, so it flips the sign and keeps the
+// node set. Degenerate tets are left as they are and rejected by the validation. Returns the number
+// of tets that were flipped.
 int OrientAndValidateTetMesh(TetMesh& mesh);
 
 // Walks a text buffer line by line and token by token, keeping the 1-based line number so every

@@ -1,4 +1,4 @@
-// Signed singular value decomposition of a 3x3 matrix (Irving et al. 2004; MATH.md §0).
+// Signed singular value decomposition of a 3x3 matrix (Irving et al. 2004; docs/math.md §0.2).
 #pragma once
 
 #include "plugin/common.h"
@@ -13,7 +13,7 @@ struct SignedSvd {
   Mat3 V;
 };
 
-// Computes the signed SVD of G (MATH.md §0: flip u_3 / v_3 and s_3 when det U or det V < 0).
+// Computes the signed SVD of G (docs/math.md §0.2: flip u_3 / v_3 and s_3 when det U or det V < 0).
 SignedSvd CalcSignedSvd(const Mat3& G);
 
 // Rotation of the polar decomposition G = R S taken from the signed SVD: R = U V^T (det R = +1,

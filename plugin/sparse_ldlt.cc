@@ -228,4 +228,14 @@ void SparseLdlt::SolveBlock(double* b, Eigen::Index outer_stride) const {
     for (int c = 0; c < kWidth; ++c) b[perm_[k] + c * outer_stride] = w[k * kWidth + c];
 }
 
+double SparseLdlt::CalcFactorWork() const {
+  if (!analyzed_) return 0.0;
+  double work = 0.0;
+  for (int j = 0; j < n_; ++j) {
+    const double c = col_start_[j + 1] - col_start_[j];
+    work += 0.5 * c * (c + 3.0);
+  }
+  return work;
+}
+
 }  // namespace taut

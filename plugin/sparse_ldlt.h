@@ -9,11 +9,11 @@
 namespace taut {
 
 // Sparse P A P^T = L D L^T of a symmetric matrix A (L unit lower triangular, D diagonal, P a
-// fill-reducing AMD permutation), for A = M + h D + h^2 K of the implicit step (DESIGN.md step 2,
-// MATH.md §5). The pattern of A is fixed per body while its values change every step, so the work
-// is split into a symbolic phase (Analyze, once per body: ordering, elimination tree, column
-// counts, every buffer) and a numeric phase (Factorize, every step) plus solves that never touch
-// the heap.
+// fill-reducing AMD permutation), for A = M + h D + h^2 K of the implicit step (docs/math.md §5.1;
+// docs/architecture.md §3, stage 2). The pattern of A is fixed per body while its values change
+// every step, so the work is split into a symbolic phase (Analyze, once per body: ordering,
+// elimination tree, column counts, every buffer) and a numeric phase (Factorize, every step) plus
+// solves that never touch the heap.
 //
 // Algorithm: Davis' up-looking "LDL" (T. A. Davis, "Algorithm 849: a concise sparse Cholesky
 // factorization package", ACM TOMS 31(4), 2005). Row k of L solves L(0:k,0:k) D l = A(0:k,k) with
@@ -58,6 +58,9 @@ class SparseLdlt {
   int rows() const { return n_; }
   // Nonzeros of L strictly below the diagonal (the unit diagonal is not stored).
   int nonzeros_in_L() const { return analyzed_ ? col_start_[n_] : 0; }
+  // Multiply-adds of one Factorize, sum_j c_j (c_j + 3) / 2 with c_j = nonzeros of column j of L
+  // (the left-looking update of each column by its row pattern); 0 before Analyze.
+  double CalcFactorWork() const;
   // (n) perm[k] = column of A eliminated k-th, i.e. (P A P^T)(k, j) = A(perm[k], perm[j]).
   const std::vector<int>& permutation() const { return perm_; }
   // True after Analyze.

@@ -10,7 +10,7 @@
 namespace taut {
 
 // Immutable rest geometry of a tet body. Tets are positively oriented:
-// det[X1-X4, X2-X4, X3-X4] > 0 (MATH.md §0 node order).
+// det[X1-X4, X2-X4, X3-X4] > 0 (docs/math.md §0.1 node order).
 struct TetMesh {
   std::vector<Vec3> nodes;               // (num_nodes) rest positions [m]
   std::vector<std::array<int, 4>> tets;  // (num_tets x 4) node indices

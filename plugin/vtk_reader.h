@@ -15,10 +15,11 @@ namespace taut {
 // Tokens may be spread over lines freely; keywords are case-insensitive. FIELD and METADATA blocks
 // in the dataset part are skipped, and reading stops at POINT_DATA or CELL_DATA. Every point is
 // kept; cells of other types (triangles, vertices, ...) are skipped after their point ids are
-// range-checked. VTK orders tet nodes with det[X2-X1, X3-X1, X4-X1] > 0, the opposite of MATH.md
-// §0, so tets get nodes 0 and 1 swapped where needed (internal::OrientAndValidateTetMesh) and the
-// mesh is validated. mesh.source is path. Throws MeshFileError ("file:line: reason") on any parse
-// error, including binary files and files without tetrahedra.
+// range-checked. VTK orders tet nodes with det[X2-X1, X3-X1, X4-X1] > 0, the opposite of
+// docs/math.md §0.1, so tets get nodes 0 and 1 swapped where needed
+// (internal::OrientAndValidateTetMesh) and the mesh is validated. mesh.source is path. Throws
+// MeshFileError ("file:line: reason") on any parse error, including binary files and files without
+// tetrahedra.
 TetMesh ReadVtkMesh(const std::string& path);
 
 namespace internal {

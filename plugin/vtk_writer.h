@@ -21,9 +21,9 @@ struct VtkFields {
 // positions (e.g. the deformed state, one per node) when given, else the rest nodes. Reals are
 // written with std::to_chars (shortest text that reads back to the same double), so a file read
 // back with ReadVtkMesh reproduces them bit for bit. Tets are written in VTK's node order (nodes 0
-// and 1 swapped, so VTK sees det[X2-X1, X3-X1, X4-X1] > 0 for a positive tet of MATH.md §0), which
-// ReadVtkMesh undoes. Throws InputError on mismatched sizes, bad field names, out-of-range node
-// indices, or when the file cannot be written (naming the path).
+// and 1 swapped, so VTK sees det[X2-X1, X3-X1, X4-X1] > 0 for a positive tet of docs/math.md §0.1),
+// which ReadVtkMesh undoes. Throws InputError on mismatched sizes, bad field names, out-of-range
+// node indices, or when the file cannot be written (naming the path).
 void WriteVtkMesh(const std::string& path, const TetMesh& mesh,
                   const std::vector<Vec3>* positions = nullptr, const VtkFields& fields = {});
 

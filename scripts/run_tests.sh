@@ -55,6 +55,12 @@ stage_licenses() {
   bash scripts/check_licenses.sh build/release
 }
 
+# Stage 1c: every citation of docs/ names a file and section that exist, and no file cites the
+# design notes kept outside the repository (scripts/check_citations.sh; needs no build).
+stage_citations() {
+  bash scripts/check_citations.sh
+}
+
 # Stage 5: the opt-in CHOLMOD build's solver tests (CHOLMOD itself, backend choice, FEM steps).
 # CholmodCholeskyTest.SolvesDoNotAllocateButFactorizeDoes is left out: on Cooper Lake CPUs
 # OpenBLAS 0.3.21's small-matrix dgemm kernel (dgemm_small_kernel_nn_COOPERLAKE) calls malloc,
@@ -151,6 +157,7 @@ current=""
 
 if ((run_release)); then run_stage release; fi
 if ((run_release)); then run_stage licenses; fi
+if ((run_release)); then run_stage citations; fi
 if ((run_consumer)); then run_stage consumer; fi
 if ((run_asan)); then run_stage asan; fi
 if ((run_asan)); then run_stage fuzz; fi

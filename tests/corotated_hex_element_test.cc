@@ -167,9 +167,9 @@ TEST(CorotatedHexElementTest, RotationIsProperForInvertedElements) {
 }
 
 TEST(CorotatedHexElementTest, CenterRotationIgnoresBendingButInscribedTetAliasesIt) {
-  // Pure bending mode x = X + A edge s1 s2 e1 on a cube of edge 0.5 (MATH.md §4 caveat). On the
-  // tet {1,4,6,7}, s1 s2 = -s3, so it sees the shear G = I - 2 A e1 e3^T (X3 = edge s3 / 2) whose
-  // polar rotation is atan(A): 2.862 deg at A = 0.05. G(0) = I: no rotation.
+  // Pure bending mode x = X + A edge s1 s2 e1 on a cube of edge 0.5 (docs/math.md §4.4 caveat). On
+  // the tet {1,4,6,7}, s1 s2 = -s3, so it sees the shear G = I - 2 A e1 e3^T (X3 = edge s3 / 2)
+  // whose polar rotation is atan(A): 2.862 deg at A = 0.05. G(0) = I: no rotation.
   std::mt19937 rng(8);
   const double edge = 0.5;
   const HexRestElement rest =

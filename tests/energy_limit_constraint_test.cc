@@ -270,7 +270,7 @@ TEST(EnergyLimitConstraintTest, HexBodyRowsHaveEightNodesAndTheFrozenRotationJac
     const HexNodes xe = hexes.GatherElement(x, e);
     const double energy = CalcHexElementEnergy(rest, xe, HexRotationMethod::kCenterPolar);
     EXPECT_NEAR(row.C, 1.0 - energy / u_max, 1e-9 * energy / u_max);
-    // FD of C over the body's positions with the element rotation frozen at x (MATH.md §4).
+    // FD of C over the body's positions with the element rotation frozen at x (docs/math.md §4.5).
     const Mat3 R = CalcHexRotation(rest, xe, HexRotationMethod::kCenterPolar);
     VecX J = VecX::Zero(x.size());
     for (int n = 0; n < 8; ++n) J.segment<3>(3 * row.nodes[n]) = row.J[n];

@@ -207,7 +207,7 @@ TEST(EnergyLimitRowsTest, HexJacobianMatchesCentralDifferencesWithFrozenRotation
 }
 
 TEST(EnergyLimitRowsTest, HexJacobianApproximatesFullGradientAtSmallStrain) {
-  // MATH.md §4: neglecting dR/dx costs about 2a relative error at nodal strain noise a.
+  // docs/math.md §4.5: neglecting dR/dx costs about 2a relative error at nodal strain noise a.
   std::mt19937 rng(9);
   const LameParameters lame = TestLame();
   for (int trial = 0; trial < 20; ++trial) {

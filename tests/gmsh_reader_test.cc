@@ -119,7 +119,7 @@ TEST(GmshReaderTest, RoundTripsVersion41WithBlocksAndNonContiguousTags) {
 TEST(GmshReaderTest, ReorientsTetsGivenInEitherOrientation) {
   const TetMesh mesh = MakeTestMesh();
   std::string text = Gmsh22Text(mesh);
-  // Give every second tet in MATH.md's orientation instead of Gmsh's: both read the same.
+  // Every second tet in taut's orientation (docs/math.md §0.1), not Gmsh's: both read the same.
   for (std::size_t e = 0; e < mesh.tets.size(); e += 2) {
     const std::string gmsh = TetTags(mesh, e) + "\n", ours = TetTags(mesh, e, true) + "\n";
     text.replace(text.find(gmsh), gmsh.size(), ours);

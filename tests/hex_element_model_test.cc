@@ -41,7 +41,7 @@ TEST(HexLatticeTest, BoxLatticeSharesNodesWithBoxTetMeshAndFollowsCornerSigns) {
   for (const auto& h : lattice.hexes) {
     Vec3 centre = Vec3::Zero();
     for (int a = 0; a < 8; ++a) centre += lattice.nodes[h[a]] / 8.0;
-    // Node a sits at centre + half_cell .* s_a (MATH.md §4 ordering).
+    // Node a sits at centre + half_cell .* s_a (docs/math.md §4.1 ordering).
     for (int a = 0; a < 8; ++a)
       EXPECT_LT((lattice.nodes[h[a]] - centre - half_cell.cwiseProduct(HexCornerSign(a))).norm(),
                 1e-12);

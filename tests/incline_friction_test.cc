@@ -1,6 +1,6 @@
 // Coulomb friction of a soft block on a real incline (a tilted static plane): it sticks below
-// tan(theta) = mu and slides above it with a = g (sin theta - mu cos theta) (MATH.md §5 friction
-// rows on the disk).
+// tan(theta) = mu and slides above it with a = g (sin theta - mu cos theta) (docs/math.md §5.5
+// friction rows on the disk).
 #include <gtest/gtest.h>
 
 #include <cmath>

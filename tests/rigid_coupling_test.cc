@@ -1,4 +1,4 @@
-// Two-way coupling of deformable and dynamic rigid bodies in one island (DESIGN.md "Islands"):
+// Two-way coupling of deformable and dynamic rigid bodies in one island (docs/architecture.md §4):
 // rigid bodies rest on soft ones, impacts conserve momentum, bones drag flesh and flesh drags
 // bones, and Bullet's rigid-rigid contacts inside the island hold a stack.
 #include <gtest/gtest.h>

@@ -29,7 +29,8 @@ TEST(SignedSvdTest, RandomAndInvertedMatrices) {
 }
 
 TEST(SignedSvdTest, ReflectionIsInvertedNotIdentity) {
-  // With unsigned values a reflection has s = (1,1,1) and passes every strain limit (MATH.md §0).
+  // With unsigned values a reflection has s = (1,1,1) and passes every strain limit
+  // (docs/math.md §0.2).
   const Mat3 G = Vec3(1, 1, -1).asDiagonal();
   const SignedSvd svd = CalcSignedSvd(G);
   EXPECT_NEAR(svd.s[2], -1.0, 1e-14);

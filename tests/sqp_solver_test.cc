@@ -108,7 +108,7 @@ TEST(SqpSolverTest, NoActiveRowsMeansNoLcp) {
 }
 
 TEST(SqpSolverTest, OrthogonalProjectionFreezesTheVerticalColumn) {
-  // Paper A §5: with orthogonal projection every deformation violates (MATH.md §6 A1), so a
+  // Paper A §5: with orthogonal projection every deformation violates (docs/math.md §6 A1), so a
   // compliant column fixed at its bottom barely moves, while hyperbolic lets it sag.
   auto top_drop = [](StrainProjection mode) {
     BulletWorldHolder holder;

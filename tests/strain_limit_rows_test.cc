@@ -1,4 +1,4 @@
-// Strain-limit rows: FD checks of every mode's Jacobian and the claims of MATH.md §2-§3.
+// Strain-limit rows: FD checks of every mode's Jacobian and the claims of docs/math.md §2-§3.
 #include "constraints/strain_limit_rows.h"
 
 #include <gtest/gtest.h>
@@ -201,7 +201,7 @@ TEST(StrainLimitRowsTest, JacobianMatchesFdOnRandomStatesForEveryMode) {
   }
 }
 
-// MATH.md §2: exact down to tiny gaps when the FD step is h = 1e-3 gap (gap clamp off).
+// docs/math.md §2.2: exact down to tiny gaps when the FD step is h = 1e-3 gap (gap clamp off).
 TEST(StrainLimitRowsTest, JacobianMatchesFdNearRepeatedValues) {
   std::mt19937 rng(20);
   for (const StrainProjection mode : kAllModes) {
@@ -285,7 +285,7 @@ TEST(StrainLimitRowsTest, KinkAtZeroFrameEntryIsFinite) {
   }
 }
 
-// MATH.md §3: with a single limited axis the ellipsoid rows equal the hyperbolic rows.
+// docs/math.md §3.5: with a single limited axis the ellipsoid rows equal the hyperbolic rows.
 TEST(StrainLimitRowsTest, EllipsoidEqualsHyperbolicForSingleLimitedAxis) {
   std::mt19937 rng(40);
   for (int trial = 0; trial < 200; ++trial) {
@@ -329,7 +329,7 @@ double EffectiveLimit(StrainProjection mode, const Mat3& Q, const Mat3& V, doubl
   return lo - 1.0;
 }
 
-// MATH.md §3 / §6 A3: ellipsoid gives exactly d in any frame, hyperbolic d / max_j |V'_j1|,
+// docs/math.md §3.6 / §6 A3: ellipsoid gives exactly d in any frame, hyperbolic d / max_j |V'_j1|,
 // up to sqrt(3) d when v_1 is the frame diagonal.
 TEST(StrainLimitRowsTest, IsotropicLimitsEllipsoidExactHyperbolicUpToSqrt3) {
   std::mt19937 rng(50);
@@ -357,7 +357,7 @@ TEST(StrainLimitRowsTest, IsotropicLimitsEllipsoidExactHyperbolicUpToSqrt3) {
   EXPECT_NEAR(EffectiveLimit(StrainProjection::kHyperbolic, Q, V, d, /*paper=*/false), d, 1e-9);
 }
 
-// Beam load path of MATH.md §3: G = Rz(phi) diag(a(1 + 1e-3), a) Rz(phi)^T (+) (1 - eps).
+// Beam load path of docs/math.md §3.6: G = Rz(phi) diag(a(1 + 1e-3), a) Rz(phi)^T (+) (1 - eps).
 Mat3 BeamG(double phi_deg, double eps) {
   const double a = 1.0 + 0.3 * eps;
   const Mat3 R = Eigen::AngleAxisd(phi_deg * kPi / 180.0, Vec3::UnitZ()).toRotationMatrix();
@@ -394,7 +394,7 @@ double FirstViolation(const StrainLimitParams& params, double phi_deg) {
   return 1.0;
 }
 
-// MATH.md §3 beam table: hyperbolic, LI (caps 2 and 10) and ellipsoid (= hyperbolic).
+// docs/math.md §3.6 beam table: hyperbolic, LI (caps 2 and 10) and ellipsoid (= hyperbolic).
 TEST(StrainLimitRowsTest, SingleTetBeamTableOfMathNote) {
   struct Entry {
     double phi, hyper, strain, li2, li10;
@@ -424,7 +424,7 @@ TEST(StrainLimitRowsTest, SingleTetBeamTableOfMathNote) {
   }
 }
 
-// MATH.md §3 / §6 A1: orthogonal projection is violated by any deformation on the beam path,
+// docs/math.md §3.6 / §6 A1: orthogonal projection is violated by any deformation on the beam path,
 // and even for isotropic limits with V = I.
 TEST(StrainLimitRowsTest, OrthogonalProjectionViolatesAtAnyDeformation) {
   for (const double phi : {0.0, 10.0, 22.5, 45.0}) {
@@ -543,7 +543,7 @@ TEST(StrainLimitRowsTest, MaterialAxisStrainAndFrame) {
 }
 
 // Principal stretches of F computed independently of the rows (Eigen's JacobiSVD), signed like
-// MATH.md §0: the smallest is negated when det F < 0 (an inverted tet).
+// docs/math.md §0.2: the smallest is negated when det F < 0 (an inverted tet).
 Vec3 IndependentPrincipalStretches(const Mat3& F) {
   Eigen::JacobiSVD<Mat3> svd(F);
   Vec3 s = svd.singularValues();

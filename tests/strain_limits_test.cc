@@ -1,4 +1,4 @@
-// Strain-limit settings: validation messages, kappa conversion and caps (MATH.md §3).
+// Strain-limit settings: validation messages, kappa conversion and caps (docs/math.md §3.1).
 #include "constraints/strain_limits.h"
 
 #include <gtest/gtest.h>
@@ -52,7 +52,7 @@ TEST(StrainLimitsTest, FactoriesAndDefaultsAreValid) {
 }
 
 // Hyperbolic limits equal on every limited axis (per bound) are evaluated as ellipsoid rows
-// (MATH.md §3: identical for one axis, isotropy-consistent for more); unequal limits, other
+// (docs/math.md §3.5: identical for one axis, isotropy-consistent for more); unequal limits, other
 // modes and equal_limits_use_ellipsoid = false keep the requested rule.
 TEST(StrainLimitsTest, EqualHyperbolicLimitsSelectTheEllipsoidRows) {
   const auto evaluated = [](const StrainLimitSettings& s) {
@@ -152,7 +152,7 @@ TEST(StrainLimitsTest, ValidateRejectsBadFramesAndOptions) {
   EXPECT_EQ(ValidateMessage(s), "");
 }
 
-// MATH.md §3: kappa = 1/|s - 1|, 0 for unlimited; OP / LI deviations use the caps.
+// docs/math.md §3.1: kappa = 1/|s - 1|, 0 for unlimited; OP / LI deviations use the caps.
 TEST(StrainLimitsTest, ParamsStoreKappaAndCappedDeviations) {
   StrainLimitSettings s =
       StrainLimitSettings::PerAxis(Vec3(0.95, 0.0, 0.8), Vec3(1.05, 1.25, kUnlimitedStretch));

@@ -1,4 +1,4 @@
-// Finite-difference checks of the signed-SVD derivatives (MATH.md §1-§2, R1).
+// Finite-difference checks of the signed-SVD derivatives (docs/math.md §1-§2 and §2 R1).
 #include "constraints/svd_derivatives.h"
 
 #include <gtest/gtest.h>
@@ -142,7 +142,7 @@ TEST(SvdDerivativesTest, SingularVectorGradientMatchesFdOnRandomAndInvertedState
   EXPECT_LT(Percentile(errors, 1.0), 1e-6);
 }
 
-// MATH.md §2: the closed form stays exact as the gap closes when h << gap (h = 1e-3 gap).
+// docs/math.md §2.2: the closed form stays exact as the gap closes when h << gap (h = 1e-3 gap).
 TEST(SvdDerivativesTest, SingularVectorGradientExactNearRepeatedValuesWithSmallStep) {
   std::mt19937 rng(3);
   for (const bool inverted_pair : {false, true}) {

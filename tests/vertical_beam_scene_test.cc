@@ -16,13 +16,13 @@ TEST(VerticalBeamSceneTest, HyperbolicAndEllipsoidHoldTheTransverseLimitOrthogon
   for (int c = 0; c < 2; ++c) {
     // The column collapses (no freezing) ...
     EXPECT_LT(scene.CalcTopHeight(c), 0.9) << "column " << c;
-    // ... and the strain along the limited axis stays within MATH.md §3's bound for the
+    // ... and the strain along the limited axis stays within docs/math.md §3.6's bound for the
     // hyperbolic rule, 1 + d / max(|cos phi|, |sin phi|) <= 1 + sqrt(2) d, plus the tolerance.
     EXPECT_GT(scene.first_violation_step(c), 0);
     EXPECT_LT(scene.max_limited_axis_strain(c), 0.05 * std::sqrt(2.0) + 0.005) << "column " << c;
     EXPECT_TRUE(scene.world().deformable_body(c).x().allFinite());
   }
-  // One limited axis: ellipsoid equals hyperbolic (MATH.md §3). Since issue 11 a hyperbolic
+  // One limited axis: ellipsoid equals hyperbolic (docs/math.md §3.5). Since issue 11 a hyperbolic
   // request whose limited axes share their limits is evaluated as the ellipsoid rows
   // (StrainLimitSettings::equal_limits_use_ellipsoid), so both columns run the same rows.
   EXPECT_NEAR(scene.max_limited_axis_strain(0), scene.max_limited_axis_strain(1), 1e-6);
@@ -39,7 +39,7 @@ namespace taut {
 namespace {
 
 // SQP iterations per constrained step of a column with hyperbolic limits, with the exact
-// Jacobian (dV/dx by MATH.md §2) or the frozen-frame approximation (dV/dx = 0).
+// Jacobian (dV/dx by docs/math.md §2.2) or the frozen-frame approximation (dV/dx = 0).
 double MeanSqpIterations(bool frozen, double* worst_violation) {
   BulletWorldHolder holder;
   DeformableBodySettings settings;
