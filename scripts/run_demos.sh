@@ -14,31 +14,6 @@ set -euo pipefail
 # shellcheck source-path=SCRIPTDIR source=build.sh
 source "$(dirname "${BASH_SOURCE[0]}")/build.sh"
 
-# OpenBLAS picks its kernels when it loads and falls back to its generic Prescott ones on CPUs it
-# does not know (Debian's 0.3.21 on some AVX-512 Intel Xeons). Only builds with
-# -DTAUT_WITH_CHOLMOD=ON link a BLAS: when BINARY loads OpenBLAS, OPENBLAS_CORETYPE is unset and
-# the core it picks is Prescott, this exports the widest core the CPU runs (SkylakeX: AVX-512 F,
-# BW, DQ, VL; Haswell: AVX2 and FMA). A default build loads no BLAS and is left as it is.
-taut_fix_openblas_coretype() {
-  local binary="$1" core flags
-  [[ -z "${OPENBLAS_CORETYPE:-}" ]] || return 0
-  ldd "${binary}" 2>/dev/null | grep -q 'libopenblas' || return 0
-  # With OPENBLAS_VERBOSE=2 the library prints "Core: <name>" on stderr as it loads.
-  core="$(OPENBLAS_VERBOSE=2 "${binary}" --help 2>&1 >/dev/null)" || true
-  core="$(sed -n '/^Core: /{s///p;q}' <<<"${core}")"
-  [[ "${core}" == Prescott ]] || return 0
-  flags=" $(grep -m 1 '^flags' /proc/cpuinfo) "
-  if [[ "${flags}" == *" avx512f "* && "${flags}" == *" avx512bw "* &&
-    "${flags}" == *" avx512dq "* && "${flags}" == *" avx512vl "* ]]; then
-    export OPENBLAS_CORETYPE=SkylakeX
-  elif [[ "${flags}" == *" avx2 "* && "${flags}" == *" fma "* ]]; then
-    export OPENBLAS_CORETYPE=Haswell
-  else
-    return 0
-  fi
-  taut_stage "OpenBLAS chose its generic Prescott kernels; OPENBLAS_CORETYPE=${OPENBLAS_CORETYPE}"
-}
-
 usage() {
   sed -n '2,12p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
 }
