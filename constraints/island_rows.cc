@@ -28,10 +28,14 @@ double IslandRows::Collect(double h, const std::vector<IslandBody*>& bodies,
 
 void IslandRows::WarmStart(const KeyedMultipliers& from, VecX& lambda) const {
   lambda.setZero(size());
+  OverwriteByKey(from, lambda);
+}
+
+void IslandRows::OverwriteByKey(const KeyedMultipliers& from, VecX& values) const {
   for (size_t c = 0; c < rows_.size(); ++c) {
     const auto it =
         std::lower_bound(from.begin(), from.end(), std::make_pair(rows_[c].key, -HUGE_VAL));
-    if (it != from.end() && it->first == rows_[c].key) lambda[c] = it->second;
+    if (it != from.end() && it->first == rows_[c].key) values[c] = it->second;
   }
 }
 

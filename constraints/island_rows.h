@@ -32,6 +32,8 @@ class IslandRows {
   void WarmStart(const KeyedMultipliers& from, VecX& lambda) const;
   // to <- the nonzero multipliers of the rows by key, sorted.
   void Store(const VecX& lambda, KeyedMultipliers& to) const;
+  // values[c] <- the value of `from` with row c's key where `from` has one; other rows keep theirs.
+  void OverwriteByKey(const KeyedMultipliers& from, VecX& values) const;
   // Row counts by type into stats (rows_strain, ...).
   void CountTypes(StepStats& stats) const;
   // J v of a row for per-body velocities v.

@@ -27,10 +27,11 @@ namespace taut {
 //     then lambda_bar_c <- Proj_c(y_c(v)),
 //   until the KKT residuals at (v, lambda_bar) are within tolerance (constraints/kkt_certificate.h).
 // rho_c = penalty_scale / w_c with w_c = sum_i J_ci^T M_i^-1 J_ci (a diagonal Delassus estimate
-// from lumped masses; no W is formed). Rows local to one body (strain, energy, node contact) keep
-// H on A's sparsity pattern: one sparse factorization per Newton iteration. Rows that couple two
-// bodies (rigid contacts, joints, deformable-deformable) enter H matrix-free and the step is
-// solved by PCG preconditioned with the per-body factors.
+// from lumped masses; no W is formed), for limit rows kept by key within a multiplier iteration.
+// Rows local to one body (strain, energy, node contact) keep H on A's sparsity pattern: one
+// sparse factorization per Newton iteration. Rows that couple two bodies (rigid contacts, joints,
+// deformable-deformable) enter H matrix-free and the step is solved by PCG preconditioned with
+// the per-body factors.
 class PrimalSolver {
  public:
   // One step h for the island `bodies` (entered with v = v*, left with the constrained v).
@@ -53,6 +54,10 @@ class PrimalSolver {
   bool WarmStartVelocities(const std::vector<IslandBody*>& bodies);
   // rho_c of every row from the diagonal Delassus estimate (friction rows: their normal's).
   void CalcPenalties(const std::vector<IslandBody*>& bodies, const PrimalSettings& settings);
+  // Keeps the limit rows' rho by key for the Newton iterations and line-search trials of one
+  // multiplier iteration, so grad Phi is the gradient of the Phi the line search measures
+  // (docs/math.md §5.8, penalties).
+  void KeepPenalties();
   // g0_c with g_c(v + dv) = g0_c + J_c (v + dv) at the collected rows, and which rows H can hold
   // on the bodies' patterns.
   void LinearizeRows(double h, const std::vector<IslandBody*>& bodies);
@@ -96,6 +101,8 @@ class PrimalSolver {
   KeyedMultipliers iterate_;   // lambda_bar of this step by key
   VecX lambda_bar_, lambda_;   // estimates, and Proj(y(v)) at the Newton iterate
   VecX rho_, g0_, jv_, s_;     // penalties, g_c(v) = g0 + J v, J v, J d
+  KeyedMultipliers kept_rho_;  // limit rows' rho of this multiplier iteration by key
+  bool rho_kept_ = false;
   VecX d_unit_;                // D_c of scalar rows (0 or 1)
   std::vector<Eigen::Matrix2d> d_disk_;  // D of a friction pair, on its first tangent row
   std::vector<char> in_pattern_;         // row's same-body blocks fit the patterns

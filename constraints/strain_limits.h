@@ -70,8 +70,9 @@ struct StrainLimitSettings {
   // Activation margin tau >= 0 (may be +inf): emit rows with C < tau. C is the remaining fraction
   // of the limit (1 at rest, 0 at the limit), so tau = 0.2 emits rows past 80 % of their limit.
   double activation_margin = kDefaultStrainActivationMargin;
-  // Gap clamp epsilon of docs/math.md §2 R1 [s^2 units], >= 0, finite. Default 1e-2.
-  double svd_gap_epsilon = 1e-2;
+  // Gap clamp epsilon of docs/math.md §2 R1 [s^2 units], >= 0, finite. Default 1e-6: exact
+  // derivatives except at near-repeated values (the SQP re-evaluates the rows at every iterate).
+  double svd_gap_epsilon = 1e-6;
   // Use the frozen-frame Jacobian (dV/dx = 0), for comparison with the exact one. Default false.
   bool freeze_frame_jacobian = false;
 
@@ -105,7 +106,7 @@ struct StrainLimitParams {
   bool has_min = false;  // some axis has a compress limit (else no C_min rows in any mode)
   bool has_max = false;  // some axis has a stretch limit (else no C_max rows in any mode)
   double activation_margin = kDefaultStrainActivationMargin;  // tau
-  double svd_gap_epsilon = 1e-2;                              // R1 epsilon
+  double svd_gap_epsilon = 1e-6;                              // R1 epsilon
   bool freeze_frame_jacobian = false;                         // dV/dx := 0
   double hyperbolic_row_band = kDefaultHyperbolicRowBand;     // emit C_j <= C_min + band
 };
