@@ -60,8 +60,7 @@ void JointSource::AddJoint(btTypedConstraint& joint, const RigidIslandBody* a,
   info2.m_numIterations = info.m_numIterations;
   info2.m_damping = info.m_damping;
   joint.getInfo2(&info2);
-  const std::uint64_t joint_id =
-      static_cast<std::uint64_t>(joint.getUserConstraintId() >= 0 ? joint.getUserConstraintId() : 0);
+  const int joint_id = joint.getUserConstraintId() >= 0 ? joint.getUserConstraintId() : 0;
   for (int r = 0; r < n; ++r) {
     JointRow row;
     row.a = a;
@@ -79,7 +78,7 @@ void JointSource::AddJoint(btTypedConstraint& joint, const RigidIslandBody* a,
                                            : static_cast<double>(buffer[r].hi);
     row.lo = std::max(row.lo, -breaking);
     row.hi = std::min(row.hi, breaking);
-    row.key = key_prefix_ | (((joint_id << 8) + rows_.size()) & ((std::uint64_t{1} << 48) - 1));
+    row.key = key_.Pack(joint_id, rows_.size());
     rows_.push_back(row);
   }
 }

@@ -9,6 +9,7 @@
 
 #include "bullet_bridge/rigid_island_body.h"
 #include "constraints/constraint_row.h"
+#include "constraints/row_key_layouts.h"
 
 namespace taut {
 
@@ -18,7 +19,8 @@ namespace taut {
 // Rows with bounds [0, +inf) are unilateral (joint limits); others bilateral with their bounds.
 class JointSource final : public ConstraintSource {
  public:
-  explicit JointSource(int source_id) : key_prefix_(static_cast<std::uint64_t>(source_id) << 48) {}
+  // `source_id` < 2^16 (row keys).
+  explicit JointSource(int source_id) : key_(kJointRowKey, source_id) {}
 
   // Clears the rows (start of a step).
   void Clear() { rows_.clear(); }
@@ -46,7 +48,7 @@ class JointSource final : public ConstraintSource {
   // Violation of a row at the iterate (see ConstraintRow::violation).
   double CalcViolation(const IslandIterate& iterate, const JointRow& row) const;
 
-  std::uint64_t key_prefix_;
+  RowKeyPacker<2> key_;  // kJointRowKey with this source's id
   std::vector<JointRow> rows_;
 };
 

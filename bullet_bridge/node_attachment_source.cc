@@ -14,7 +14,7 @@ NodeAttachmentSource::NodeAttachmentSource(const DeformableBody& body,
       rigid_(rigid),
       nodes_(std::move(nodes)),
       local_(std::move(local)),
-      key_prefix_(static_cast<std::uint64_t>(source_id) << 48) {
+      key_(kNodeAttachmentRowKey, source_id) {
   TAUT_DEMAND(rigid != nullptr, "body '", body.name(), "': attachment to a null rigid body");
   TAUT_DEMAND(nodes_.size() == local_.size(), "body '", body.name(), "': ", nodes_.size(),
               " attached nodes but ", local_.size(), " offsets");
@@ -45,7 +45,7 @@ int NodeAttachmentSource::AppendIslandRows(const IslandIterate& iterate,
     for (int axis = 0; axis < 3; ++axis) {
       const Vec3 e = Vec3::Unit(axis);
       ConstraintRow& row = rows.emplace_back();
-      row.key = key_prefix_ | (static_cast<std::uint64_t>(k) * 3 + axis);
+      row.key = key_.Pack(k, axis);
       row.C = gap[axis];
       row.type = RowType::kJoint;
       row.bilateral = true;

@@ -6,6 +6,7 @@
 
 #include "bullet_bridge/rigid_island_body.h"
 #include "constraints/constraint_row.h"
+#include "constraints/row_key_layouts.h"
 
 namespace taut {
 
@@ -15,7 +16,7 @@ namespace taut {
 class NodeAttachmentSource final : public ConstraintSource {
  public:
   // `local` holds each node's offset in the rigid body's frame. Throws InputError for a node
-  // out of range or a size mismatch.
+  // out of range, a size mismatch or a source id beyond 2^16 - 1.
   NodeAttachmentSource(const DeformableBody& body, const RigidIslandBody* rigid,
                        std::vector<int> nodes, std::vector<Vec3> local, int source_id);
 
@@ -32,7 +33,7 @@ class NodeAttachmentSource final : public ConstraintSource {
   const RigidIslandBody* rigid_;
   std::vector<int> nodes_;
   std::vector<Vec3> local_;
-  std::uint64_t key_prefix_;
+  RowKeyPacker<2> key_;  // kNodeAttachmentRowKey with this source's id
   mutable std::vector<Vec3> anchors_;  // scratch
 };
 

@@ -15,7 +15,7 @@ namespace taut {
 RigidContactSource::RigidContactSource(const DeformableBody& body, const ContactSurface& surface,
                                        int source_id, double friction, double margin)
     : body_(body),
-      key_prefix_(static_cast<std::uint64_t>(source_id) << 48),
+      key_(kRigidContactRowKey, source_id),
       friction_(friction),
       margin_(margin) {
   TAUT_DEMAND(std::isfinite(friction) && friction >= 0.0, "body '", body.name(),
@@ -64,8 +64,10 @@ int RigidContactSource::AppendIslandRows(const IslandIterate& iterate,
     const int rigid_index = partner.rigid != nullptr ? iterate.IndexOf(partner.rigid) : -1;
     const Vec3 com = ToEigen(transform.getOrigin());
     const double mu = friction_ * static_cast<double>(object.getFriction());
-    // Stable partner id for warm starting: the object's index in the world.
-    const std::uint64_t object_id = static_cast<std::uint64_t>(object.getWorldArrayIndex()) & 4095;
+    // Stable partner id for warm starting: the object's index in the world, or for an object in
+    // no world (index -1, e.g. given to set_objects) its position among the partners.
+    const bool outside_world = object.getWorldArrayIndex() < 0;
+    const int object_id = outside_world ? static_cast<int>(o) : object.getWorldArrayIndex();
     for (size_t i = 0; i < points_.size(); ++i) {
       const ContactPoint& point = points_[i];
       if (!Moves(point)) continue;  // fixed or kinematic: nothing to solve
@@ -80,11 +82,9 @@ int RigidContactSource::AppendIslandRows(const IslandIterate& iterate,
       d[0] = contact.normal;
       CalcContactTangents(contact.normal, d[1], d[2]);
       const Vec3 r = p - contact.gap * contact.normal - com;
-      const std::uint64_t key =
-          key_prefix_ | ((static_cast<std::uint64_t>(i) * 4096 + object_id) * 3);
       for (int k = 0; k < 3; ++k) {
         ConstraintRow& row = rows.emplace_back();
-        row.key = key + k;
+        row.key = key_.Pack(i, outside_world, object_id, k);
         row.C = k == 0 ? contact.gap : 0.0;
         row.body = body_index;
         row.type = RowType::kContact;

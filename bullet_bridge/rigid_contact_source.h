@@ -10,6 +10,7 @@
 
 #include "bullet_bridge/rigid_island_body.h"
 #include "constraints/constraint_row.h"
+#include "constraints/row_key_layouts.h"
 #include "plugin/contact_surface.h"
 
 namespace taut {
@@ -24,7 +25,8 @@ class RigidContactSource final : public ConstraintSource {
  public:
   // `friction` is the body's Coulomb coefficient, combined with each object's by the product
   // (Bullet's default combiner); `margin` [m] is how close a point must be to get rows. The
-  // contact points are those of `surface` (usually MakeBodyContactSurface(body.model())).
+  // contact points are those of `surface` (usually MakeBodyContactSurface(body.model()));
+  // `source_id` < 2^16 (row keys).
   RigidContactSource(const DeformableBody& body, const ContactSurface& surface, int source_id,
                      double friction, double margin);
 
@@ -52,7 +54,7 @@ class RigidContactSource final : public ConstraintSource {
   double CalcPointGap(const IslandIterate& iterate, const Vec3& p) const;
 
   const DeformableBody& body_;
-  std::uint64_t key_prefix_;
+  RowKeyPacker<4> key_;  // kRigidContactRowKey with this source's id
   double friction_;
   double margin_;
   std::vector<ContactPoint> points_;

@@ -14,10 +14,10 @@ Vec3 PointVelocity(const IslandIterate& iterate, const RigidIslandBody* r, const
   const VecX& v = iterate.v(iterate.IndexOf(r));
   return v.head<3>() + Vec3(v.tail<3>()).cross(rel);
 }
-// A stable id of a collision object (its broadphase unique id), 20 bits.
-std::uint64_t ObjectId(const btCollisionObject* object) {
+// A stable id of a collision object (its broadphase unique id).
+int ObjectId(const btCollisionObject* object) {
   const btBroadphaseProxy* proxy = object->getBroadphaseHandle();
-  return static_cast<std::uint64_t>(proxy != nullptr ? proxy->m_uniqueId : 0) & 0xFFFFF;
+  return proxy != nullptr ? proxy->m_uniqueId : 0;
 }
 }  // namespace
 
@@ -51,9 +51,8 @@ void RigidManifoldSource::AddManifold(const btPersistentManifold& manifold,
     p.bounce = approach > static_cast<double>(info.m_restitutionVelocityThreshold)
                    ? static_cast<double>(point.m_combinedRestitution) * approach
                    : 0.0;
-    p.key = key_prefix_ |
-            (((ObjectId(object_a) << 20 | ObjectId(object_b)) * 4 + static_cast<std::uint64_t>(i)) * 3 &
-             ((std::uint64_t{1} << 48) - 1));
+    for (int k = 0; k < 3; ++k)
+      p.keys[k] = key_.Pack(ObjectId(object_a), ObjectId(object_b), i, k);
     points_.push_back(p);
   }
 }
@@ -82,7 +81,7 @@ int RigidManifoldSource::AppendIslandRows(const IslandIterate& iterate,
     const Vec3 d[3] = {p.normal, p.tangent[0], p.tangent[1]};
     for (int k = 0; k < 3; ++k) {
       ConstraintRow& row = rows.emplace_back();
-      row.key = p.key + k;
+      row.key = p.keys[k];
       row.C = k == 0 ? c : 0.0;
       row.type = RowType::kRigidContact;
       row.friction_of = k;

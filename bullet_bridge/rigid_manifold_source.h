@@ -5,10 +5,12 @@
 #include <BulletCollision/NarrowPhaseCollision/btPersistentManifold.h>
 #include <BulletDynamics/ConstraintSolver/btContactSolverInfo.h>
 
+#include <array>
 #include <vector>
 
 #include "bullet_bridge/rigid_island_body.h"
 #include "constraints/constraint_row.h"
+#include "constraints/row_key_layouts.h"
 
 namespace taut {
 
@@ -22,7 +24,7 @@ struct RigidContactPoint {
   double distance;   // signed separation at the step start [m], < 0 penetrating
   double bounce;     // restitution target of the normal relative velocity [m/s], >= 0
   double friction;   // combined Coulomb coefficient
-  std::uint64_t key; // identity for warm starting
+  std::array<std::uint64_t, 3> keys;  // identity for warm starting: normal, two friction rows
 };
 
 // Rows of the contact points: normal J v >= max(-d/h, bounce) (d scaled by erp when
@@ -30,7 +32,8 @@ struct RigidContactPoint {
 // two friction rows on the Coulomb disk of each normal row.
 class RigidManifoldSource final : public ConstraintSource {
  public:
-  explicit RigidManifoldSource(int source_id) : key_prefix_(static_cast<std::uint64_t>(source_id) << 48) {}
+  // `source_id` < 2^16 (row keys).
+  explicit RigidManifoldSource(int source_id) : key_(kRigidManifoldRowKey, source_id) {}
 
   // Clears the points (start of a step).
   void Clear() { points_.clear(); }
@@ -53,7 +56,7 @@ class RigidManifoldSource final : public ConstraintSource {
   // Normal-row value C = h (J v - target) at the iterate.
   double CalcNormalC(const IslandIterate& iterate, const RigidContactPoint& p) const;
 
-  std::uint64_t key_prefix_;
+  RowKeyPacker<4> key_;  // kRigidManifoldRowKey with this source's id
   double erp_ = 0.2;
   std::vector<RigidContactPoint> points_;
 };

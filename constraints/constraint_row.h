@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "constraints/island_body.h"
+#include "constraints/row_key.h"
 #include "plugin/deformable_body.h"
 
 namespace taut {
@@ -31,7 +32,7 @@ enum class RowType : std::uint8_t {
 // velocity blocks, linear (block 0) and angular (block 1). C is dimensionless for limit rows, J
 // in 1/m; contact rows have C in m and dimensionless J.
 struct ConstraintRow {
-  std::uint64_t key = 0;  // identity for warm starting (source id and element, axis, bound)
+  std::uint64_t key = 0;  // identity for warm starting (constraints/row_key_layouts.h)
   double C = 0.0;         // value at the iterate, >= 0 feasible (bilateral: = 0 feasible)
   int body = -1;          // index of side A's body in the island
   int num_nodes = 0;
@@ -72,9 +73,6 @@ inline void CalcContactTangents(const Vec3& n, Vec3& t1, Vec3& t2) {
   t1 = (std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized();
   t2 = n.cross(t1);
 }
-
-// Source id of a row key (bits 48-63; every source packs its id there).
-inline int RowKeySource(std::uint64_t key) { return static_cast<int>(key >> 48); }
 
 // Receives curvature blocks of rows for the SQP metric / Newton matrix (docs/math.md §5.9):
 // blocks of weight * [-d^2 C / dx^2]_+ between two nodes of one deformable body.

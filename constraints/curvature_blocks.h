@@ -2,16 +2,9 @@
 // shared by the strain- and energy-limit sources.
 #pragma once
 
-#include <cstdint>
-
 #include "constraints/constraint_row.h"
 
 namespace taut {
-
-// The bits of a row key below the source id (bits 0-47): the source's own packed identity.
-inline std::uint64_t RowKeyPayload(std::uint64_t key) {
-  return key & ((std::uint64_t{1} << 48) - 1);
-}
 
 // sink(body; nodes[a], nodes[b]) += weight * H(3a..3a+2, 3b..3b+2) for every ordered node pair
 // (a, b) of the element, the diagonal a = b included. H: (3N x 3N), node-major xyz.

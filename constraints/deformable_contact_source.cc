@@ -56,7 +56,7 @@ DeformableContactSource::DeformableContactSource(const DeformableBody& a,
     : a_(a),
       b_(b),
       surfaces_{surface_a, surface_b},
-      key_prefix_(static_cast<std::uint64_t>(source_id) << 48),
+      key_(kDeformableContactRowKey, source_id),
       friction_(friction),
       margin_(margin) {
   TAUT_DEMAND(&a != &b, "body '", a.name(), "': deformable contact needs two different bodies");
@@ -136,14 +136,9 @@ int DeformableContactSource::AppendIslandRows(const IslandIterate& iterate,
     Vec3 d[3];
     d[0] = hit.normal;
     CalcContactTangents(hit.normal, d[1], d[2]);
-    const std::uint64_t key =
-        key_prefix_ | ((static_cast<std::uint64_t>(hit.point) * 2 + hit.direction) *
-                           (std::uint64_t{1} << 20) +
-                       static_cast<std::uint64_t>(hit.triangle)) *
-                          3;
     for (int k = 0; k < 3; ++k) {
       ConstraintRow& row = rows.emplace_back();
-      row.key = key + k;
+      row.key = key_.Pack(hit.direction, hit.point, hit.triangle, k);
       row.C = k == 0 ? hit.gap : 0.0;
       row.type = RowType::kContact;
       row.friction_of = k;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "constraints/constraint_row.h"
+#include "constraints/row_key_layouts.h"
 #include "plugin/contact_surface.h"
 
 namespace taut {
@@ -19,7 +20,7 @@ class DeformableContactSource final : public ConstraintSource {
  public:
   // Triangles of a surface whose corners are not single nodes (embedded surfaces) are not used
   // as targets (its points still touch the other body's triangles). `friction` is the combined
-  // Coulomb coefficient; `margin` [m] > 0.
+  // Coulomb coefficient; `margin` [m] > 0; `source_id` < 2^16 (row keys).
   DeformableContactSource(const DeformableBody& a, const ContactSurface& surface_a,
                           const DeformableBody& b, const ContactSurface& surface_b, int source_id,
                           double friction, double margin);
@@ -47,7 +48,7 @@ class DeformableContactSource final : public ConstraintSource {
   const DeformableBody& a_;
   const DeformableBody& b_;
   ContactSurface surfaces_[2];
-  std::uint64_t key_prefix_;
+  RowKeyPacker<4> key_;  // kDeformableContactRowKey with this source's id
   double friction_, margin_;
   mutable std::vector<Hit> hits_;  // scratch of the last FindHits
 };

@@ -35,13 +35,10 @@ EnergyLimitConstraint::EnergyLimitConstraint(const DeformableBody& body,
     : body_(body),
       tets_((CheckElementType(body), dynamic_cast<const TetElementModel*>(&body.model()))),
       hexes_(dynamic_cast<const HexElementModel*>(&body.model())),
-      settings_(settings) {
+      settings_(settings),
+      key_(kEnergyLimitRowKey, source_id) {
   settings_.Validate(body.model().num_elements(), "body '" + body.name() + "' energy limits");
-  TAUT_DEMAND(source_id >= 0 && source_id < (1 << 16), "energy limits: source id ", source_id,
-              " out of range");
   u_max_ = CalcElementEnergyLimits(settings_, GatherRestVolumes(tets_, hexes_));
-  key_prefix_ = static_cast<std::uint64_t>(source_id) << 48;
-  source_id_ = source_id;
 }
 
 double EnergyLimitConstraint::CalcElementEnergy(const VecX& x, int e) const {
@@ -87,7 +84,7 @@ int EnergyLimitConstraint::AppendRows(const VecX& x, int body_index,
     // Cheap energy test first; forces only for rows that are emitted.
     if (!(CalcEnergyLimitValue(CalcElementEnergy(x, e), u_max_[e]) < tau)) continue;
     ConstraintRow& row = rows.emplace_back();
-    row.key = key_prefix_ | static_cast<std::uint64_t>(e);  // one bound per element
+    row.key = key_.Pack(e);  // one bound per element
     row.body = body_index;
     row.type = RowType::kEnergyLimit;
     FillRow(x, e, row);
@@ -100,8 +97,8 @@ void EnergyLimitConstraint::AddIslandCurvature(const IslandIterate& iterate,
                                                int count, CurvatureSink& sink) const {
   for (int c = 0; c < count; ++c) {
     const ConstraintRow& row = rows[c];
-    if (RowKeySource(row.key) != source_id_ || !(weights[c] > 0.0)) continue;
-    const int e = static_cast<int>(RowKeyPayload(row.key));  // key = prefix | element
+    if (!key_.Owns(row.key) || !(weights[c] > 0.0)) continue;
+    const int e = static_cast<int>(key_.Unpack(row.key)[0]);
     const VecX& x = iterate.x(row.body);
     const int* nodes = body_.model().element_nodes(e);
     if (tets_ != nullptr) {

@@ -7,6 +7,7 @@
 #include "constraints/constraint_row.h"
 #include "constraints/energy_limit_rows.h"
 #include "constraints/energy_limits.h"
+#include "constraints/row_key_layouts.h"
 #include "plugin/hex_element_model.h"
 #include "plugin/tet_element_model.h"
 
@@ -18,7 +19,7 @@ namespace taut {
 class EnergyLimitConstraint final : public BodyConstraintSource {
  public:
   // `body` must be a tet or hex body; settings are validated (throws InputError naming the body).
-  // `source_id` (< 2^16) makes row keys unique among the sources of a world.
+  // `source_id` (< 2^16, else InputError) makes row keys unique among the sources of a world.
   EnergyLimitConstraint(const DeformableBody& body, const EnergyLimitSettings& settings,
                         int source_id);
 
@@ -50,8 +51,7 @@ class EnergyLimitConstraint final : public BodyConstraintSource {
   const HexElementModel* hexes_;
   EnergyLimitSettings settings_;
   std::vector<double> u_max_;  // U_max,e [J], +inf = unlimited
-  std::uint64_t key_prefix_;
-  int source_id_;
+  RowKeyPacker<1> key_;        // kEnergyLimitRowKey with this source's id
 };
 
 }  // namespace taut

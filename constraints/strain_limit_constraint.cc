@@ -20,12 +20,12 @@ const TetElementModel& AsTets(const DeformableBody& body) {
 
 StrainLimitConstraint::StrainLimitConstraint(const DeformableBody& body,
                                              const StrainLimitSettings& settings, int source_id)
-    : body_(body), tets_(AsTets(body)), settings_(settings), source_id_(source_id) {
+    : body_(body),
+      tets_(AsTets(body)),
+      settings_(settings),
+      key_(kStrainLimitRowKey, source_id) {
   settings_.Validate(tets_.num_elements(), "body '" + body.name() + "' strain limits");
-  TAUT_DEMAND(source_id >= 0 && source_id < (1 << 16), "strain limits: source id ", source_id,
-              " out of range");
   params_ = CalcStrainLimitParams(settings_);
-  key_prefix_ = static_cast<std::uint64_t>(source_id) << 48;
   // Hyperbolic and ellipsoid rows of principal axis i have C = 1 - kappa_eff (s_i - 1) with
   // kappa_eff <= max_j kappa^j (|V'_ji| <= 1; ||K w|| <= max kappa), so no row of an element is
   // active (C < tau) while every stretch lies in [1 - (1-tau)/max kappa_min,
@@ -68,7 +68,7 @@ int StrainLimitConstraint::AppendRows(const VecX& x, int body_index,
     const int* nodes = tets_.element_nodes(e);
     for (const StrainLimitRow& r : element_rows_) {
       ConstraintRow& row = rows.emplace_back();
-      row.key = key_prefix_ | r.key.Pack();
+      row.key = key_.PackFields(r.key.Fields());
       row.C = r.C;
       row.body = body_index;
       row.type = RowType::kStrainLimit;
@@ -95,7 +95,7 @@ void StrainLimitConstraint::AddIslandCurvature(const IslandIterate& iterate,
   };
   for (int c = 0; c < count; ++c) {
     const ConstraintRow& row = rows[c];
-    if (RowKeySource(row.key) != source_id_ || !(weights[c] > 0.0)) continue;
+    if (!key_.Owns(row.key) || !(weights[c] > 0.0)) continue;
     const StrainLimitKey key = StrainLimitKey::Unpack(RowKeyPayload(row.key));
     const TetRestRows& r = tets_.rest().elements[key.element].r;
     if (key.element != element || row.body != body) {

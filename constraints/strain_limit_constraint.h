@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "constraints/constraint_row.h"
+#include "constraints/row_key_layouts.h"
 #include "constraints/strain_limit_rows.h"
 #include "plugin/tet_element_model.h"
 
@@ -14,7 +15,7 @@ namespace taut {
 class StrainLimitConstraint final : public BodyConstraintSource {
  public:
   // `body` must be a tet body; settings are validated (throws InputError naming the body).
-  // `source_id` (< 2^16) makes row keys unique among the sources of a world.
+  // `source_id` (< 2^16, else InputError) makes row keys unique among the sources of a world.
   StrainLimitConstraint(const DeformableBody& body, const StrainLimitSettings& settings,
                         int source_id);
 
@@ -45,8 +46,7 @@ class StrainLimitConstraint final : public BodyConstraintSource {
   const TetElementModel& tets_;
   StrainLimitSettings settings_;
   StrainLimitParams params_;
-  std::uint64_t key_prefix_;
-  int source_id_;
+  RowKeyPacker<4> key_;  // kStrainLimitRowKey with this source's id
   std::vector<StrainLimitRow> element_rows_;  // scratch, reused
   bool screen_ = false;                       // IsSurelyInactive applies
   double stretch_lo_ = 0.0, stretch_hi_ = HUGE_VAL;  // stretches that certainly emit no row

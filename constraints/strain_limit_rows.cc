@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "constraints/row_key_layouts.h"
+
 namespace taut {
 namespace {
 
@@ -218,19 +220,21 @@ bool StrainLimitKey::operator==(const StrainLimitKey& other) const {
          bound == other.bound;
 }
 
+std::array<std::int64_t, 4> StrainLimitKey::Fields() const {
+  return {element, axis, principal_axis, static_cast<std::int64_t>(bound)};
+}
+
 std::uint64_t StrainLimitKey::Pack() const {
-  return ((static_cast<std::uint64_t>(element) * 3 + axis) * 3 + principal_axis) * 2 +
-         static_cast<std::uint64_t>(bound);
+  return PackRowKeyPayload(kStrainLimitRowKey, Fields());
 }
 
 StrainLimitKey StrainLimitKey::Unpack(std::uint64_t packed) {
+  const std::array<std::int64_t, 4> fields = UnpackRowKeyPayload(kStrainLimitRowKey, packed);
   StrainLimitKey key;
-  key.bound = static_cast<StrainBound>(packed % 2);
-  packed /= 2;
-  key.principal_axis = static_cast<std::int8_t>(packed % 3);
-  packed /= 3;
-  key.axis = static_cast<std::int8_t>(packed % 3);
-  key.element = static_cast<int>(packed / 3);
+  key.element = static_cast<int>(fields[0]);
+  key.axis = static_cast<std::int8_t>(fields[1]);
+  key.principal_axis = static_cast<std::int8_t>(fields[2]);
+  key.bound = static_cast<StrainBound>(fields[3]);
   return key;
 }
 

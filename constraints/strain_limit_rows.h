@@ -40,9 +40,12 @@ struct StrainLimitKey {
 
   // Equal element, axis, principal_axis and bound.
   bool operator==(const StrainLimitKey& other) const;
-  // One integer for hash maps: ((element * 3 + axis) * 3 + principal_axis) * 2 + bound.
+  // The fields in the order of the row key's layout (kStrainLimitRowKey,
+  // constraints/row_key_layouts.h): element, axis, principal_axis, bound.
+  std::array<std::int64_t, 4> Fields() const;
+  // One integer for hash maps: the fields packed as a row key's payload (no source id).
   std::uint64_t Pack() const;
-  // Inverse of Pack (bits above the packed value, e.g. a source id, must be cleared).
+  // Inverse of Pack (bits above the payload, e.g. a source id, must be cleared).
   static StrainLimitKey Unpack(std::uint64_t packed);
 };
 
