@@ -8,6 +8,7 @@
 #include <chrono>
 #include <limits>
 
+#include "bullet_bridge/body_pose.h"
 #include "bullet_bridge/eigen_bullet.h"
 #include "plugin/tet_element_model.h"
 
@@ -70,6 +71,36 @@ DeformableBody* DeformableWorld::AddHexBody(std::shared_ptr<const HexLattice> la
                                             HexRotationMethod method) {
   auto model = std::make_unique<HexElementModel>(std::move(lattice), settings.material, method);
   return AddDeformableBody(std::make_unique<DeformableBody>(std::move(model), settings));
+}
+
+DeformableBody* DeformableWorld::AddTetBody(const TetMesh& mesh,
+                                            const DeformableBodySettings& settings,
+                                            const btTransform& pose) {
+  return AddTetBody(std::make_shared<const TetMesh>(mesh), settings, pose);
+}
+
+DeformableBody* DeformableWorld::AddTetBody(std::shared_ptr<const TetMesh> mesh,
+                                            const DeformableBodySettings& settings,
+                                            const btTransform& pose) {
+  auto body = std::make_unique<DeformableBody>(
+      std::make_unique<TetElementModel>(std::move(mesh), settings.material), settings);
+  PlaceAtPose(*body, pose);  // before the broadphase sees its bounds
+  return AddDeformableBody(std::move(body));
+}
+
+DeformableBody* DeformableWorld::AddHexBody(const HexLattice& lattice,
+                                            const DeformableBodySettings& settings,
+                                            const btTransform& pose, HexRotationMethod method) {
+  return AddHexBody(std::make_shared<const HexLattice>(lattice), settings, pose, method);
+}
+
+DeformableBody* DeformableWorld::AddHexBody(std::shared_ptr<const HexLattice> lattice,
+                                            const DeformableBodySettings& settings,
+                                            const btTransform& pose, HexRotationMethod method) {
+  auto body = std::make_unique<DeformableBody>(
+      std::make_unique<HexElementModel>(std::move(lattice), settings.material, method), settings);
+  PlaceAtPose(*body, pose);
+  return AddDeformableBody(std::move(body));
 }
 
 DeformableBody* DeformableWorld::AddDeformableBody(std::unique_ptr<DeformableBody> body) {
@@ -154,15 +185,17 @@ void DeformableWorld::AttachNodesToRigidBody(DeformableBody* body, const std::ve
 
 void DeformableWorld::SetContactSurface(DeformableBody* body, const SurfaceMesh& surface) {
   Entry& entry = FindEntry(body);
-  const auto* hexes = dynamic_cast<const HexElementModel*>(&body->model());
-  TAUT_DEMAND(hexes != nullptr, "body '", body->name(),
-              "': SetContactSurface needs a hex body (tet bodies touch through their boundary)");
-  ContactSurface embedded =
-      MakeEmbeddedContactSurface(hexes->lattice(), EmbedSurface(hexes->lattice(), surface));
+  ContactSurface embedded;
+  try {
+    embedded = MakeEmbeddedBodyContactSurface(body->model(), surface);
+  } catch (const InputError& error) {
+    throw InputError(internal::Concat("body '", body->name(), "': SetContactSurface: ",
+                                      error.what()));
+  }
   entry.contacts->set_surface(embedded);
-  // Other deformables still touch the lattice's boundary triangles; this body touches them
-  // through the embedded points.
-  embedded.triangles = MakeHexContactSurface(hexes->lattice()).triangles;
+  // Other deformables still touch the body's boundary triangles (lattice or tet boundary); this
+  // body touches them through the embedded points.
+  embedded.triangles = MakeBodyContactSurface(body->model()).triangles;
   embedded.node_triangles = false;
   entry.surface = std::move(embedded);
   for (auto it = pair_contacts_.begin(); it != pair_contacts_.end();)
@@ -184,9 +217,17 @@ void DeformableWorld::RemoveDeformableBody(DeformableBody* body) {
   bodies_.erase(it);
 }
 
+int DeformableWorld::stepSimulation(btScalar time_step, int max_sub_steps,
+                                    btScalar fixed_time_step) {
+  call_stats_ = StepStats();
+  call_stats_.substeps = 0;
+  return btDiscreteDynamicsWorld::stepSimulation(time_step, max_sub_steps, fixed_time_step);
+}
+
 void DeformableWorld::internalSingleStepSimulation(btScalar h) {
   if (bodies_.empty()) {
     btDiscreteDynamicsWorld::internalSingleStepSimulation(h);
+    call_stats_.substeps++;
     return;
   }
   const auto start = std::chrono::steady_clock::now();
@@ -194,6 +235,7 @@ void DeformableWorld::internalSingleStepSimulation(btScalar h) {
   stats_.ms_total = MsSince(start);
   stats_.ms_rigid = stats_.ms_total - stats_.ms_unconstrained - stats_.ms_rows - stats_.ms_solve -
                     stats_.ms_integrate;
+  AddSubstepStats(stats_, call_stats_);
 }
 
 void DeformableWorld::UpdateKinematicAttachments() {
@@ -451,7 +493,7 @@ void DeformableWorld::SolveIslands(double h) {
     StepStats island_stats;
     bodies_[island.first_deformable]->solver.Solve(h, island.bodies, island.sources,
                                                    solver_settings_, island_stats);
-    AccumulateStats(island_stats);
+    AddIslandStats(island_stats, stats_);
     stats_.islands++;
   }
 }
@@ -459,40 +501,6 @@ void DeformableWorld::SolveIslands(double h) {
 void DeformableWorld::EndSteps(double h) {
   for (auto& entry : bodies_) entry->body().EndStep(h);
   for (RigidIslandBody* rigid : coupled_) rigid->EndStep();
-}
-
-void DeformableWorld::AccumulateStats(const StepStats& island_stats) {
-  stats_.ms_rows += island_stats.ms_rows;
-  stats_.ms_solve += island_stats.ms_solve;
-  stats_.rows_strain += island_stats.rows_strain;
-  stats_.rows_energy += island_stats.rows_energy;
-  stats_.rows_contact += island_stats.rows_contact;
-  stats_.rows_rigid_contact += island_stats.rows_rigid_contact;
-  stats_.rows_joint += island_stats.rows_joint;
-  stats_.pgs_sweeps += island_stats.pgs_sweeps;
-  stats_.sqp_iterations = std::max(stats_.sqp_iterations, island_stats.sqp_iterations);
-  stats_.restoration_iterations += island_stats.restoration_iterations;
-  stats_.active_set_solves += island_stats.active_set_solves;
-  stats_.stationarity = std::max(stats_.stationarity, island_stats.stationarity);
-  stats_.lcp_residual = std::max(stats_.lcp_residual, island_stats.lcp_residual);
-  stats_.violation_before = std::max(stats_.violation_before, island_stats.violation_before);
-  stats_.violation_after = std::max(stats_.violation_after, island_stats.violation_after);
-  stats_.converged = stats_.converged && island_stats.converged;
-  stats_.islands_dual += island_stats.islands_dual;
-  stats_.islands_primal += island_stats.islands_primal;
-  stats_.newton_iterations += island_stats.newton_iterations;
-  stats_.pcg_iterations += island_stats.pcg_iterations;
-  stats_.newton_factorizations += island_stats.newton_factorizations;
-  stats_.kkt_primal = std::max(stats_.kkt_primal, island_stats.kkt_primal);
-  stats_.kkt_complementarity =
-      std::max(stats_.kkt_complementarity, island_stats.kkt_complementarity);
-  stats_.kkt_dual = std::max(stats_.kkt_dual, island_stats.kkt_dual);
-  for (int i = 0; i < 5; ++i) {
-    stats_.kkt_primal_by_type[i] =
-        std::max(stats_.kkt_primal_by_type[i], island_stats.kkt_primal_by_type[i]);
-    stats_.kkt_complementarity_by_type[i] = std::max(stats_.kkt_complementarity_by_type[i],
-                                                     island_stats.kkt_complementarity_by_type[i]);
-  }
 }
 
 void DeformableWorld::solveConstraints(btContactSolverInfo& info) {

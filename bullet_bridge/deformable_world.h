@@ -54,6 +54,21 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   DeformableBody* AddHexBody(std::shared_ptr<const HexLattice> lattice,
                              const DeformableBodySettings& settings,
                              HexRotationMethod method = HexRotationMethod::kCenterPolar);
+  // The same, placed at `pose` (a rotation and a translation [m]): the nodes start at
+  // pose * rest position, at rest (no elastic force; the elements are rotation invariant). The
+  // rest mesh and everything given in its frame stay as they are: FixNodesWhere's rest positions,
+  // strain-limit frames, SetContactSurface's surface. Throws InputError (before anything is
+  // added) when the pose's basis is not a rotation.
+  DeformableBody* AddTetBody(const TetMesh& mesh, const DeformableBodySettings& settings,
+                             const btTransform& pose);
+  DeformableBody* AddTetBody(std::shared_ptr<const TetMesh> mesh,
+                             const DeformableBodySettings& settings, const btTransform& pose);
+  DeformableBody* AddHexBody(const HexLattice& lattice, const DeformableBodySettings& settings,
+                             const btTransform& pose,
+                             HexRotationMethod method = HexRotationMethod::kCenterPolar);
+  DeformableBody* AddHexBody(std::shared_ptr<const HexLattice> lattice,
+                             const DeformableBodySettings& settings, const btTransform& pose,
+                             HexRotationMethod method = HexRotationMethod::kCenterPolar);
   // Adds a body built elsewhere (any ElementModel).
   DeformableBody* AddDeformableBody(std::unique_ptr<DeformableBody> body);
   // Removes and destroys the body.
@@ -73,10 +88,11 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   void AttachNodesToRigidBody(DeformableBody* body, const std::vector<int>& nodes,
                               const btRigidBody* rigid);
   // Makes `surface` (a closed surface in the body's rest frame, e.g. the one a hex lattice was
-  // voxelized from) the body's contact surface: it is embedded in the hex lattice, and each of
-  // its vertices contacts rigid objects through the 8 nodes of its hex (trilinear weights).
-  // Without it a hex body touches through its lattice's boundary corners. Throws InputError for
-  // a body that is not a hex body or a surface that cannot be embedded.
+  // voxelized from) the body's contact surface: it is embedded in the hex lattice or tet mesh,
+  // and each of its vertices contacts rigid objects through the 8 nodes of its hex (trilinear
+  // weights) or the 4 nodes of its tet (barycentric weights; EmbedSurfaceInTets). Without it a
+  // body touches through its boundary nodes. Throws InputError for a body that is neither a hex
+  // nor a tet body or a surface that cannot be embedded.
   void SetContactSurface(DeformableBody* body, const SurfaceMesh& surface);
   // Removes every constraint source (limits) of the body.
   void ClearLimits(DeformableBody* body);
@@ -89,6 +105,14 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   const DeformableBody& deformable_body(int i) const { return bodies_[i]->body(); }
   // Statistics of the last substep.
   const StepStats& last_step_stats() const { return stats_; }
+  // btDiscreteDynamicsWorld::stepSimulation [s], keeping the totals of its substeps.
+  int stepSimulation(btScalar time_step, int max_sub_steps = 1,
+                     btScalar fixed_time_step = btScalar(1.) / btScalar(60.)) override;
+  // Totals of the substeps of the last stepSimulation call (AddSubstepStats): times [ms] and
+  // counts summed, violations and residuals the worst substep's, converged when every substep
+  // converged, `substeps` their number (0 when the call only accumulated time; substeps without
+  // deformable bodies count with zero figures). After a SimulationError: the substeps before it.
+  const StepStats& last_call_stats() const { return call_stats_; }
 
  protected:
   // One fixed substep; Bullet's sequence calls solveConstraints below between collision
@@ -163,8 +187,6 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   RigidIslandBody* FindCoupledBody(const btCollisionObject& object, int& island);
   // The island body of a dynamic rigid body (made on first use).
   RigidIslandBody* FindRigidIslandBody(btRigidBody* rigid);
-  // Adds the SQP statistics of one island to the substep's.
-  void AccumulateStats(const StepStats& island_stats);
   // The entry of a body; throws InputError when the body is not in this world.
   Entry& FindEntry(const DeformableBody* body);
   // Installs `source` on the body's entry, replacing any earlier source of the same type T.
@@ -183,6 +205,7 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   int next_source_id_ = 0;
   btEmptyAlgorithm::CreateFunc empty_algorithm_;
   StepStats stats_;
+  StepStats call_stats_;  // totals of the last stepSimulation call
 };
 
 }  // namespace taut

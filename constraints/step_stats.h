@@ -1,4 +1,5 @@
-// Per-substep statistics of the deformable step, readable by the user and written by the demos.
+// Per-substep statistics of the deformable step, readable by the user and written by the demos,
+// and how the figures of islands and of substeps add up.
 #pragma once
 
 namespace taut {
@@ -63,10 +64,25 @@ struct StepStats {
 
   int islands = 0;                // islands solved by the SQP (with at least one row source)
   int rigid_bodies_coupled = 0;   // dynamic rigid bodies solved inside deformable islands
+  // World substeps these figures cover: 1 for one substep, their count in the totals of a whole
+  // stepSimulation call (AddSubstepStats, DeformableWorld::last_call_stats).
+  int substeps = 1;
 
   int rows_total() const {
     return rows_strain + rows_energy + rows_contact + rows_rigid_contact + rows_joint;
   }
 };
+
+// Adds one island's SQP statistics to those of its substep `step`: row and solve times [ms] and
+// the work counts summed, sqp_iterations the most of any island (the islands are independent
+// solves), violations and residuals the worst island's, converged only when every island
+// converged. The stage times, islands and rigid_bodies_coupled are the world's own.
+void AddIslandStats(const StepStats& island, StepStats& step);
+
+// Adds one substep's statistics to the totals of a whole stepSimulation call `call`: every time
+// [ms] and every count (rows, iterations, islands, coupled rigid bodies, substeps) summed, so a
+// per-substep mean is the total over `substeps`; violations and residuals the worst substep's;
+// converged only when every substep converged. Start `call` from StepStats with substeps = 0.
+void AddSubstepStats(const StepStats& substep, StepStats& call);
 
 }  // namespace taut

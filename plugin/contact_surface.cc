@@ -83,6 +83,50 @@ ContactSurface MakeEmbeddedContactSurface(const HexLattice& lattice,
   return result;
 }
 
+ContactSurface MakeTetEmbeddedContactSurface(const TetMesh& mesh,
+                                             const TetEmbeddedSurface& surface) {
+  ContactSurface result;
+  result.node_triangles = false;
+  for (const TetEmbeddedVertex& vertex : surface.vertices) {
+    TAUT_DEMAND(vertex.tet >= 0 && vertex.tet < static_cast<int>(mesh.tets.size()),
+                "embedded surface '", surface.source, "': tet ", vertex.tet, " out of range");
+    ContactPoint p;
+    p.num_nodes = 4;
+    for (int a = 0; a < 4; ++a) {
+      p.nodes[a] = mesh.tets[vertex.tet][a];
+      p.weights[a] = vertex.weights[a];
+    }
+    result.points.push_back(p);
+  }
+  result.triangles = surface.triangles;
+  return result;
+}
+
+ContactSurface MakeEmbeddedBodyContactSurface(const ElementModel& model,
+                                              const SurfaceMesh& surface) {
+  if (const auto* tets = dynamic_cast<const TetElementModel*>(&model))
+    return MakeTetEmbeddedContactSurface(tets->mesh(), EmbedSurfaceInTets(tets->mesh(), surface));
+  if (const auto* hexes = dynamic_cast<const HexElementModel*>(&model))
+    return MakeEmbeddedContactSurface(hexes->lattice(), EmbedSurface(hexes->lattice(), surface));
+  throw InputError(internal::Concat(surface.source,
+                                    ": surfaces can only be embedded in tet or hex bodies"));
+}
+
+std::vector<Vec3> CalcContactPointPositions(const ContactSurface& surface, const VecX& x) {
+  const int num_nodes = static_cast<int>(x.size() / 3);
+  std::vector<Vec3> positions;
+  positions.reserve(surface.points.size());
+  for (std::size_t i = 0; i < surface.points.size(); ++i) {
+    const ContactPoint& p = surface.points[i];
+    for (int k = 0; k < p.num_nodes; ++k)
+      TAUT_DEMAND(p.nodes[k] >= 0 && p.nodes[k] < num_nodes, "surface point ", i,
+                  " refers to node ", p.nodes[k], " but there are ", num_nodes,
+                  " node positions");
+    positions.push_back(CalcContactPointPosition(p, x));
+  }
+  return positions;
+}
+
 ContactSurface MakeBodyContactSurface(const ElementModel& model) {
   if (const auto* tets = dynamic_cast<const TetElementModel*>(&model))
     return MakeTetContactSurface(tets->mesh());

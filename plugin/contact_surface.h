@@ -1,6 +1,7 @@
 // The points and triangles through which a deformable body touches other bodies: boundary
 // vertices of tets, boundary corners of hex lattices, or a surface embedded in a hex lattice
-// (each point a trilinear combination of its hex's 8 nodes).
+// (each point a trilinear combination of its hex's 8 nodes) or in a tet mesh (a barycentric
+// combination of its tet's 4 nodes).
 #pragma once
 
 #include <array>
@@ -9,6 +10,7 @@
 #include "plugin/element_model.h"
 #include "plugin/embedded_surface.h"
 #include "plugin/hex_lattice.h"
+#include "plugin/tet_embedded_surface.h"
 #include "plugin/tet_mesh.h"
 
 namespace taut {
@@ -36,6 +38,14 @@ ContactSurface MakeHexContactSurface(const HexLattice& lattice);
 // The vertices and triangles of a surface embedded in the lattice (8-node points).
 ContactSurface MakeEmbeddedContactSurface(const HexLattice& lattice,
                                           const EmbeddedSurface& surface);
+// The vertices and triangles of a surface embedded in the tet mesh (4-node points).
+ContactSurface MakeTetEmbeddedContactSurface(const TetMesh& mesh,
+                                             const TetEmbeddedSurface& surface);
+// `surface` (in the rest frame) embedded in a tet or hex body's model: EmbedSurfaceInTets or
+// EmbedSurface, then the function above or MakeEmbeddedContactSurface. Throws InputError for
+// another model or a surface that cannot be embedded.
+ContactSurface MakeEmbeddedBodyContactSurface(const ElementModel& model,
+                                              const SurfaceMesh& surface);
 
 // The boundary of a tet or hex body's model (the two functions above); every node for other
 // models (points without triangles).
@@ -47,5 +57,9 @@ inline Vec3 CalcContactPointPosition(const ContactPoint& p, const VecX& x) {
   for (int k = 0; k < p.num_nodes; ++k) sum += p.weights[k] * x.segment<3>(3 * p.nodes[k]);
   return sum;
 }
+
+// Positions of every point of `surface` for node positions x (3N), e.g. an embedded surface's
+// deformed vertices for a frame. Throws InputError when a point refers to a node x does not have.
+std::vector<Vec3> CalcContactPointPositions(const ContactSurface& surface, const VecX& x);
 
 }  // namespace taut

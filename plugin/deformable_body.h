@@ -7,8 +7,10 @@
 
 #include "plugin/deformable_body_settings.h"
 #include "plugin/element_model.h"
+#include "plugin/hex_lattice.h"
 #include "plugin/implicit_system.h"
 #include "plugin/node_kind.h"
+#include "plugin/tet_mesh.h"
 
 namespace taut {
 
@@ -31,7 +33,14 @@ class DeformableBody {
   const DeformableBodySettings& settings() const { return settings_; }
   const ElementModel& model() const { return *model_; }
   ElementModel& mutable_model() { return *model_; }
+  // The rest mesh of a tet body (node positions [m]), null for other element models.
+  const TetMesh* rest_tet_mesh() const;
+  // The rest lattice of a hex body (node positions [m]), null for other element models.
+  const HexLattice* rest_hex_lattice() const;
+  // Rest volume of element e [m^3].
+  double element_rest_volume(int e) const { return model_->element_rest_volume(e); }
   int num_nodes() const { return model_->num_nodes(); }
+  int num_elements() const { return model_->num_elements(); }
   const VecX& x() const { return x_; }
   const VecX& v() const { return v_; }
   const VecX& x0() const { return x0_; }          // positions at the step start

@@ -23,6 +23,8 @@ class ElementModel {
   virtual const int* element_nodes(int e) const = 0;
   // Rest positions (3 num_nodes, node-major xyz) [m].
   virtual const VecX& rest_positions() const = 0;
+  // Rest volume of element e [m^3], > 0 (energy densities [J/m^3] times it give joules).
+  virtual double element_rest_volume(int e) const = 0;
   // Lumped mass per node from the density [kg]; `mass` is resized to num_nodes().
   virtual void CalcLumpedMass(double density, VecX& mass) const = 0;
 

@@ -24,6 +24,7 @@ class HexElementModel final : public ElementModel {
   int nodes_per_element() const override { return 8; }
   const int* element_nodes(int e) const override { return lattice_->hexes[e].data(); }
   const VecX& rest_positions() const override { return rest_positions_; }
+  double element_rest_volume(int e) const override { return rest_[e].volume; }
   void CalcLumpedMass(double density, VecX& mass) const override;
   double UpdateRotationsAndAddForces(const VecX& x, VecX& f) override;
   void AddScaledStiffness(double scale, const std::vector<int>& index_map,

@@ -30,6 +30,7 @@ class TetElementModel final : public ElementModel {
   int nodes_per_element() const override { return 4; }
   const int* element_nodes(int e) const override { return mesh_->tets[e].data(); }
   const VecX& rest_positions() const override { return rest_positions_; }
+  double element_rest_volume(int e) const override { return rest_.elements[e].volume; }
   void CalcLumpedMass(double density, VecX& mass) const override;
   double UpdateRotationsAndAddForces(const VecX& x, VecX& f) override;
   void AddScaledStiffness(double scale, const std::vector<int>& index_map,

@@ -1,9 +1,10 @@
-// Hex bodies touching through a surface embedded in their lattice: each surface vertex is a
-// contact point with 8 trilinear weights, so the surface (not the blocky lattice) rests on the
-// ground.
+// Hex and tet bodies touching through a surface embedded in their lattice or mesh: each surface
+// vertex is a contact point with 8 trilinear or 4 barycentric weights, so the surface (not the
+// blocky lattice or the coarse tet boundary) rests on the ground.
 #include <gtest/gtest.h>
 
 #include "demos/scenes/bullet_world_holder.h"
+#include "plugin/box_tet_mesher.h"
 #include "plugin/contact_surface.h"
 #include "plugin/hex_lattice.h"
 #include "plugin/surface_mesh.h"
@@ -47,7 +48,44 @@ TEST(EmbeddedContactTest, EmbeddedSurfaceRestsOnTheGroundInsteadOfTheLattice) {
   EXPECT_NEAR(surface_without, -0.05, 5e-3);  // and the surface hangs through the ground
 }
 
-TEST(EmbeddedContactTest, SetContactSurfaceRejectsTetBodies) {
+// Lowest embedded-surface vertex and lowest tet node after dropping a 0.4 m tet block whose
+// embedded box surface starts 5 cm above the block's bottom (4-node barycentric points).
+void DropTetBlock(bool embedded_contact, double& surface_bottom, double& mesh_bottom) {
+  BulletWorldHolder holder;
+  holder.AddStaticGround(1.0);
+  const TetMesh mesh = MakeBoxTetMesh(Vec3(0.4, 0.4, 0.4), 4, 4, 4, Vec3(-0.2, -0.2, 0.1));
+  const SurfaceMesh surface = MakeBoxSurface(Vec3(0.4, 0.4, 0.35), 4, 4, 4, Vec3(-0.2, -0.2, 0.15));
+  DeformableBodySettings settings;
+  settings.name = "tet block";
+  settings.material = {1e6, 0.3, 500.0};
+  settings.mass_damping = 5.0;
+  DeformableBody* block = holder.world.AddTetBody(mesh, settings);
+  if (embedded_contact) holder.world.SetContactSurface(block, surface);
+  for (int i = 0; i < 240; ++i) holder.world.stepSimulation(1.0 / 240.0, 1, 1.0 / 240.0);
+  const ContactSurface contact =
+      MakeTetEmbeddedContactSurface(mesh, EmbedSurfaceInTets(mesh, surface));
+  surface_bottom = HUGE_VAL;
+  for (const Vec3& p : CalcContactPointPositions(contact, block->x()))
+    surface_bottom = std::min(surface_bottom, p.z());
+  mesh_bottom = HUGE_VAL;
+  for (int i = 0; i < block->num_nodes(); ++i)
+    mesh_bottom = std::min(mesh_bottom, block->node_position(i).z());
+}
+
+TEST(EmbeddedContactTest, TetBodyRestsOnItsEmbeddedSurfaceInsteadOfItsBoundary) {
+  double surface_with, mesh_with, surface_without, mesh_without;
+  DropTetBlock(true, surface_with, mesh_with);
+  DropTetBlock(false, surface_without, mesh_without);
+  std::printf("tet embedded contact: surface bottom %.2e m, mesh bottom %.4f m; boundary contact: "
+              "surface bottom %.4f m, mesh bottom %.2e m\n",
+              surface_with, mesh_with, surface_without, mesh_without);
+  EXPECT_NEAR(surface_with, 0.0, 1e-4);      // the surface touches the ground
+  EXPECT_NEAR(mesh_with, -0.05, 5e-3);       // the mesh's bottom hangs through it
+  EXPECT_NEAR(mesh_without, 0.0, 1e-4);      // the default: the tet boundary touches
+  EXPECT_NEAR(surface_without, 0.05, 5e-3);  // and the surface floats above the ground
+}
+
+TEST(EmbeddedContactTest, SetContactSurfaceOutsideATetBodyNamesTheBodyAndTheVertex) {
   BulletWorldHolder holder;
   DeformableBodySettings settings;
   settings.name = "tets";
@@ -56,11 +94,16 @@ TEST(EmbeddedContactTest, SetContactSurfaceRejectsTetBodies) {
   mesh.nodes = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1)};
   mesh.tets = {{1, 0, 2, 3}};
   DeformableBody* body = holder.world.AddTetBody(mesh, settings);
+  SurfaceMesh box = MakeBoxSurface(Vec3(1, 1, 1), 1, 1, 1);  // corner (1, 1, 1) is far outside
+  box.source = "box";
   try {
-    holder.world.SetContactSurface(body, MakeBoxSurface(Vec3(1, 1, 1), 1, 1, 1));
-    FAIL() << "tet bodies have no lattice to embed in";
+    holder.world.SetContactSurface(body, box);
+    FAIL() << "the box does not fit in the tet";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("body 'tets'"), std::string::npos) << e.what();
+    const std::string message = e.what();
+    EXPECT_NE(message.find("body 'tets'"), std::string::npos) << message;
+    EXPECT_NE(message.find("box: vertex "), std::string::npos) << message;
+    EXPECT_NE(message.find(" m outside tet mesh"), std::string::npos) << message;
   }
 }
 

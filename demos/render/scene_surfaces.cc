@@ -6,7 +6,6 @@
 #include <cstdio>
 
 #include "bullet_bridge/eigen_bullet.h"
-#include "plugin/hex_element_model.h"
 
 namespace taut::render {
 
@@ -93,9 +92,7 @@ std::shared_ptr<const ContactSurface> SceneSurfaceExtractor::GetSurface(const Sc
     cached.rest_positions = model.rest_positions();
     cached.num_elements = model.num_elements();
     if (embedded >= 0) {
-      const auto& hexes = dynamic_cast<const HexElementModel&>(model);
-      cached.surface = std::make_shared<const ContactSurface>(
-          MakeEmbeddedContactSurface(hexes.lattice(), scene.embedded_surface(embedded)));
+      cached.surface = std::make_shared<const ContactSurface>(scene.embedded_surface(embedded));
     } else {
       cached.surface = std::make_shared<const ContactSurface>(MakeBodyContactSurface(model));
     }

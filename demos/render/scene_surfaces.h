@@ -42,10 +42,11 @@ struct SceneSnapshot {
   std::vector<RenderMesh> MakeMeshes() const;
 };
 
-// Extracts snapshots of a scene. Deformable tet bodies show their boundary faces, hex bodies the
-// surface embedded in them (Scene::AttachEmbeddedSurface) or else their lattice boundary; rigid
-// boxes and spheres are drawn as such, a static plane with normal +z becomes the ground; other
-// rigid shapes are left out. The boundary of each body model is computed once and cached.
+// Extracts snapshots of a scene. Deformable bodies show the surface embedded in them
+// (Scene::AttachEmbeddedSurface), else tet bodies their boundary faces and hex bodies their
+// lattice boundary; rigid boxes and spheres are drawn as such, a static plane with normal +z
+// becomes the ground; other rigid shapes are left out. The boundary of each body model is
+// computed once and cached.
 class SceneSurfaceExtractor {
  public:
   SceneSnapshot Extract(const Scene& scene);

@@ -75,25 +75,15 @@ std::vector<Scene::KeyFrame> CollectPeakKeyFrames(int step, int num_steps, doubl
   return frames;
 }
 
-namespace {
-// The hex model of body b; throws InputError when it is not a hex body.
-const HexElementModel& HexModelOf(const DeformableWorld& world, int b) {
-  const auto* hexes = dynamic_cast<const HexElementModel*>(&world.deformable_body(b).model());
-  TAUT_DEMAND(hexes != nullptr, "body '", world.deformable_body(b).name(),
-              "': surfaces can only be embedded in hex bodies");
-  return *hexes;
-}
-}  // namespace
-
 int Scene::AttachEmbeddedSurface(int body, const SurfaceMesh& surface) {
-  embedded_.push_back({body, EmbedSurface(HexModelOf(world(), body).lattice(), surface)});
+  const ElementModel& model = world().deformable_body(body).model();
+  embedded_.push_back({body, MakeEmbeddedBodyContactSurface(model, surface)});
   return static_cast<int>(embedded_.size()) - 1;
 }
 
 std::vector<Vec3> Scene::CalcEmbeddedSurfacePositions(int i) const {
   const EmbeddedSurfaceOutput& out = embedded_[i];
-  return CalcEmbeddedPositions(out.surface, HexModelOf(world(), out.body).lattice(),
-                               world().deformable_body(out.body).x());
+  return CalcContactPointPositions(out.surface, world().deformable_body(out.body).x());
 }
 
 namespace {

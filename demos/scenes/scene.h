@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "demos/scenes/bullet_world_holder.h"
-#include "plugin/embedded_surface.h"
+#include "plugin/contact_surface.h"
 #include "plugin/surface_mesh.h"
 #include "plugin/vtk_collection_writer.h"
 
@@ -49,15 +49,16 @@ class Scene {
   // Direction from the scene towards the camera of the pictures (world frame, z up).
   virtual Vec3 GetCameraDirection() const { return Vec3(0.45, -1.0, 0.5); }
 
-  // Embeds `surface` in the lattice of hex body `body` (trilinear weights per vertex) so that
-  // WriteVtkFrame also writes the deformed surface (VTK and OBJ) each frame. Returns its index.
+  // Embeds `surface` in tet or hex body `body` (MakeEmbeddedBodyContactSurface: 4 barycentric or
+  // 8 trilinear weights per vertex) so that WriteVtkFrame also writes the deformed surface (VTK
+  // and OBJ) each frame. Returns its index.
   int AttachEmbeddedSurface(int body, const SurfaceMesh& surface);
   int num_embedded_surfaces() const { return static_cast<int>(embedded_.size()); }
   // Deformed vertex positions of embedded surface i at the bodies' current positions.
   std::vector<Vec3> CalcEmbeddedSurfacePositions(int i) const;
-  // Body index and embedding of surface i.
+  // Body index and embedding of surface i (one point per vertex, a weighted sum of body nodes).
   int embedded_surface_body(int i) const { return embedded_[i].body; }
-  const EmbeddedSurface& embedded_surface(int i) const { return embedded_[i].surface; }
+  const ContactSurface& embedded_surface(int i) const { return embedded_[i].surface; }
 
   DeformableWorld& world() { return holder_.world; }
   const DeformableWorld& world() const { return holder_.world; }
@@ -66,10 +67,10 @@ class Scene {
 
  protected:
   BulletWorldHolder holder_;
-  // A surface embedded in a hex body.
+  // A surface embedded in a tet or hex body.
   struct EmbeddedSurfaceOutput {
     int body;
-    EmbeddedSurface surface;
+    ContactSurface surface;
   };
   std::vector<EmbeddedSurfaceOutput> embedded_;
   // The .pvd collections WriteVtkFrame extends.
