@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <tuple>
 
 #include "plugin/hex_element_model.h"
 #include "plugin/tet_element_model.h"
@@ -9,6 +10,31 @@
 namespace taut {
 
 namespace {
+// One contact point per vertex of an embedded surface: the nodes of the vertex's element
+// (ElementOf(vertex) indexes `elements`) with the vertex's weights, x_p = sum_a w_a x_a.
+template <typename Element, typename Surface, typename ElementOf>
+ContactSurface MakeWeightedPointSurface(const std::vector<Element>& elements,
+                                        const Surface& surface, const char* element_name,
+                                        ElementOf element_of) {
+  ContactSurface result;
+  result.node_triangles = false;
+  constexpr int kNodes = static_cast<int>(std::tuple_size<Element>::value);
+  for (const auto& vertex : surface.vertices) {
+    const int e = element_of(vertex);
+    TAUT_DEMAND(e >= 0 && e < static_cast<int>(elements.size()), "embedded surface '",
+                surface.source, "': ", element_name, " ", e, " out of range");
+    ContactPoint p;
+    p.num_nodes = kNodes;
+    for (int a = 0; a < kNodes; ++a) {
+      p.nodes[a] = elements[e][a];
+      p.weights[a] = vertex.weights[a];
+    }
+    result.points.push_back(p);
+  }
+  result.triangles = surface.triangles;
+  return result;
+}
+
 // A single-node point.
 ContactPoint NodePoint(int node) {
   ContactPoint p;
@@ -66,40 +92,14 @@ ContactSurface MakeHexContactSurface(const HexLattice& lattice) {
 
 ContactSurface MakeEmbeddedContactSurface(const HexLattice& lattice,
                                           const EmbeddedSurface& surface) {
-  ContactSurface result;
-  result.node_triangles = false;
-  for (const EmbeddedVertex& vertex : surface.vertices) {
-    TAUT_DEMAND(vertex.hex >= 0 && vertex.hex < static_cast<int>(lattice.hexes.size()),
-                "embedded surface '", surface.source, "': hex ", vertex.hex, " out of range");
-    ContactPoint p;
-    p.num_nodes = 8;
-    for (int a = 0; a < 8; ++a) {
-      p.nodes[a] = lattice.hexes[vertex.hex][a];
-      p.weights[a] = vertex.weights[a];
-    }
-    result.points.push_back(p);
-  }
-  result.triangles = surface.triangles;
-  return result;
+  return MakeWeightedPointSurface(lattice.hexes, surface, "hex",
+                                  [](const EmbeddedVertex& vertex) { return vertex.hex; });
 }
 
 ContactSurface MakeTetEmbeddedContactSurface(const TetMesh& mesh,
                                              const TetEmbeddedSurface& surface) {
-  ContactSurface result;
-  result.node_triangles = false;
-  for (const TetEmbeddedVertex& vertex : surface.vertices) {
-    TAUT_DEMAND(vertex.tet >= 0 && vertex.tet < static_cast<int>(mesh.tets.size()),
-                "embedded surface '", surface.source, "': tet ", vertex.tet, " out of range");
-    ContactPoint p;
-    p.num_nodes = 4;
-    for (int a = 0; a < 4; ++a) {
-      p.nodes[a] = mesh.tets[vertex.tet][a];
-      p.weights[a] = vertex.weights[a];
-    }
-    result.points.push_back(p);
-  }
-  result.triangles = surface.triangles;
-  return result;
+  return MakeWeightedPointSurface(mesh.tets, surface, "tet",
+                                  [](const TetEmbeddedVertex& vertex) { return vertex.tet; });
 }
 
 ContactSurface MakeEmbeddedBodyContactSurface(const ElementModel& model,
