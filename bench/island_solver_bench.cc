@@ -100,12 +100,13 @@ Setup MakeRestingSlab(int n, bool constrained) {
   Setup s;
   s.holder = std::make_unique<BulletWorldHolder>();
   if (constrained) s.holder->AddStaticGround();
-  auto mesh = std::make_shared<TetMesh>(MakeBoxTetMesh(
-      Vec3(0.8, 0.8, 0.12), n, n, std::max(2, n / 4), Vec3(-0.4, -0.4, 0.0005)));
+  auto mesh = std::make_shared<TetMesh>(
+      MakeBoxTetMesh(Vec3(0.8, 0.8, 0.12), n, n, std::max(2, n / 4), Vec3(-0.4, -0.4, 0.0005)));
   mesh->source = "resting slab";
   DeformableBody* body =
       s.holder->world.AddTetBody(mesh, MakeSceneBodySettings("slab", 5e3, 1000.0, 1.0));
-  if (constrained) s.holder->world.SetStrainLimits(body, StrainLimitSettings::Isotropic(0.96, 1.04));
+  if (constrained)
+    s.holder->world.SetStrainLimits(body, StrainLimitSettings::Isotropic(0.96, 1.04));
   return s;
 }
 
@@ -116,8 +117,8 @@ Setup MakeRollingSlab(int n, bool constrained) {
   Setup s;
   s.holder = std::make_unique<BulletWorldHolder>();
   const double top = 0.1;
-  auto mesh = std::make_shared<TetMesh>(MakeBoxTetMesh(Vec3(1.2, 0.4, top), 3 * n, n,
-                                                       std::max(2, n / 3), Vec3(-0.6, -0.2, 0.0)));
+  auto mesh = std::make_shared<TetMesh>(
+      MakeBoxTetMesh(Vec3(1.2, 0.4, top), 3 * n, n, std::max(2, n / 3), Vec3(-0.6, -0.2, 0.0)));
   mesh->source = "rolling slab";
   DeformableBody* body =
       s.holder->world.AddTetBody(mesh, MakeSceneBodySettings("slab", 20e3, 1000.0, 1.0));
@@ -213,8 +214,8 @@ void RunCase(benchmark::State& state, const Case& c, bool constrained, IslandSol
   state.counters["unconverged"] = static_cast<double>(unconverged);
   state.counters["steps"] = steps;
   state.counters["max_violation"] = max_violation;
-  state.counters["primal_share"] = dual + primal > 0 ? static_cast<double>(primal) / (dual + primal)
-                                                     : 0.0;
+  state.counters["primal_share"] =
+      dual + primal > 0 ? static_cast<double>(primal) / (dual + primal) : 0.0;
   if (s.rigid && !c.rest_height) {
     // Sanity of the rolling body: distance travelled along x and its centre height [m].
     state.counters["rigid_dx_m"] = s.rigid->getWorldTransform().getOrigin().x() - x0;
@@ -258,10 +259,9 @@ const bool kRegistered = [] {
                         {"auto", true, IslandSolverKind::kAuto}};
   for (const Case& c : cases)
     for (const Path& p : paths)
-      benchmark::RegisterBenchmark(("BM_IslandSolver/" + c.name + "/" + p.name).c_str(),
-                                   [&c, p](benchmark::State& state) {
-                                     RunCase(state, c, p.constrained, p.kind);
-                                   })
+      benchmark::RegisterBenchmark(
+          ("BM_IslandSolver/" + c.name + "/" + p.name).c_str(),
+          [&c, p](benchmark::State& state) { RunCase(state, c, p.constrained, p.kind); })
           ->Iterations(c.timed_steps)
           ->Repetitions(c.repetitions)
           ->ReportAggregatesOnly(true)

@@ -28,8 +28,8 @@ struct BeamWorld {
     settings.name = "beam";
     settings.material = {1e6, 0.3, 1000.0};
     settings.mass_damping = 1.0;
-    beam = holder.world.AddTetBody(MakeBoxTetMesh(Vec3(1.0, 0.2, 0.2), 20, 4, 4, Vec3(0, -0.1, 1.0)),
-                                   settings);
+    beam = holder.world.AddTetBody(
+        MakeBoxTetMesh(Vec3(1.0, 0.2, 0.2), 20, 4, 4, Vec3(0, -0.1, 1.0)), settings);
     beam->FixNodesWhere([](const Vec3& X) { return X.x() < 1e-9; });
   }
   void Step() { holder.world.stepSimulation(kStep, 1, kStep); }
@@ -84,7 +84,8 @@ void BM_LeaveOut_IsotropicVsPerAxisRows(benchmark::State& state) {
   VecX x = body.x();
   for (int i = 0; i < body.num_nodes(); ++i) x[3 * i] *= 1.3;  // 30 % stretch along x
   StrainLimitSettings isotropic = StrainLimitSettings::Isotropic(0.9, 1.1);
-  StrainLimitSettings per_axis = StrainLimitSettings::PerAxis(Vec3(0.9, 0.8, 0.7), Vec3(1.1, 1.2, 1.3));
+  StrainLimitSettings per_axis =
+      StrainLimitSettings::PerAxis(Vec3(0.9, 0.8, 0.7), Vec3(1.1, 1.2, 1.3));
   isotropic.activation_margin = per_axis.activation_margin = HUGE_VAL;
   StrainLimitConstraint iso(body, isotropic, 1), aniso(body, per_axis, 2);
   std::vector<ConstraintRow> rows;
@@ -102,11 +103,17 @@ void BM_LeaveOut_IsotropicVsPerAxisRows(benchmark::State& state) {
 }
 
 BENCHMARK(BM_LeaveOut_FarObjectSkipsTheNarrowPhase)
-    ->Unit(benchmark::kMillisecond)->Repetitions(5)->ReportAggregatesOnly(true);
+    ->Unit(benchmark::kMillisecond)
+    ->Repetitions(5)
+    ->ReportAggregatesOnly(true);
 BENCHMARK(BM_LeaveOut_InactiveLimitsBuildNoLcp)
-    ->Unit(benchmark::kMillisecond)->Repetitions(5)->ReportAggregatesOnly(true);
+    ->Unit(benchmark::kMillisecond)
+    ->Repetitions(5)
+    ->ReportAggregatesOnly(true);
 BENCHMARK(BM_LeaveOut_IsotropicVsPerAxisRows)
-    ->Unit(benchmark::kMillisecond)->Repetitions(5)->ReportAggregatesOnly(true);
+    ->Unit(benchmark::kMillisecond)
+    ->Repetitions(5)
+    ->ReportAggregatesOnly(true);
 
 }  // namespace
 }  // namespace taut

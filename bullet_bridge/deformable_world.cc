@@ -189,8 +189,8 @@ void DeformableWorld::SetContactSurface(DeformableBody* body, const SurfaceMesh&
   try {
     embedded = MakeEmbeddedBodyContactSurface(body->model(), surface);
   } catch (const InputError& error) {
-    throw InputError(internal::Concat("body '", body->name(), "': SetContactSurface: ",
-                                      error.what()));
+    throw InputError(
+        internal::Concat("body '", body->name(), "': SetContactSurface: ", error.what()));
   }
   entry.contacts->set_surface(embedded);
   // Other deformables still touch the body's boundary triangles (lattice or tet boundary); this

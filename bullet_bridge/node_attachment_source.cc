@@ -7,9 +7,9 @@
 
 namespace taut {
 
-NodeAttachmentSource::NodeAttachmentSource(const DeformableBody& body,
-                                           const RigidIslandBody* rigid, std::vector<int> nodes,
-                                           std::vector<Vec3> local, int source_id)
+NodeAttachmentSource::NodeAttachmentSource(const DeformableBody& body, const RigidIslandBody* rigid,
+                                           std::vector<int> nodes, std::vector<Vec3> local,
+                                           int source_id)
     : body_(body),
       rigid_(rigid),
       nodes_(std::move(nodes)),
@@ -70,7 +70,8 @@ double NodeAttachmentSource::CalcIslandMaxViolation(const IslandIterate& iterate
   CalcAnchors(iterate, anchors_, com);
   double violation = 0.0;
   for (size_t k = 0; k < nodes_.size(); ++k)
-    violation = std::max(violation, (x.segment<3>(3 * nodes_[k]) - anchors_[k]).cwiseAbs().maxCoeff());
+    violation =
+        std::max(violation, (x.segment<3>(3 * nodes_[k]) - anchors_[k]).cwiseAbs().maxCoeff());
   return violation;
 }
 

@@ -33,7 +33,7 @@ class NodeAttachmentSource final : public ConstraintSource {
   const RigidIslandBody* rigid_;
   std::vector<int> nodes_;
   std::vector<Vec3> local_;
-  RowKeyPacker<2> key_;  // kNodeAttachmentRowKey with this source's id
+  RowKeyPacker<2> key_;                // kNodeAttachmentRowKey with this source's id
   mutable std::vector<Vec3> anchors_;  // scratch
 };
 

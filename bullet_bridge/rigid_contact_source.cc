@@ -11,13 +11,9 @@
 
 namespace taut {
 
-
 RigidContactSource::RigidContactSource(const DeformableBody& body, const ContactSurface& surface,
                                        int source_id, double friction, double margin)
-    : body_(body),
-      key_(kRigidContactRowKey, source_id),
-      friction_(friction),
-      margin_(margin) {
+    : body_(body), key_(kRigidContactRowKey, source_id), friction_(friction), margin_(margin) {
   TAUT_DEMAND(std::isfinite(friction) && friction >= 0.0, "body '", body.name(),
               "': contact friction must be finite and >= 0, got ", friction);
   TAUT_DEMAND(std::isfinite(margin) && margin > 0.0, "body '", body.name(),
@@ -45,8 +41,7 @@ void RigidContactSource::set_objects(const std::vector<const btCollisionObject*>
   for (const btCollisionObject* object : objects) partners_.push_back({object, nullptr});
 }
 
-btTransform RigidContactSource::CalcPartnerTransform(const IslandIterate& iterate,
-                                                     size_t o) const {
+btTransform RigidContactSource::CalcPartnerTransform(const IslandIterate& iterate, size_t o) const {
   const ContactPartner& partner = partners_[o];
   if (partner.rigid == nullptr) return partner.object->getWorldTransform();
   return partner.rigid->PredictTransform(iterate.h(), iterate.v(iterate.IndexOf(partner.rigid)));
@@ -76,8 +71,8 @@ int RigidContactSource::AppendIslandRows(const IslandIterate& iterate,
           CalcPointShapeDistance(p, *object.getCollisionShape(), transform, margin_);
       if (!contact.valid || contact.gap >= margin_) continue;
       // Normal row C = gap, J = w_k n on the point's nodes; then the two tangents (friction on
-      // the Coulomb disk). A dynamic partner's surface point q = p - gap n moves with v + w x (q - com), so
-      // its side is J_lin = -d, J_ang = -(q - com) x d for each direction d.
+      // the Coulomb disk). A dynamic partner's surface point q = p - gap n moves with v + w x (q -
+      // com), so its side is J_lin = -d, J_ang = -(q - com) x d for each direction d.
       Vec3 d[3];
       d[0] = contact.normal;
       CalcContactTangents(contact.normal, d[1], d[2]);
@@ -123,7 +118,8 @@ double RigidContactSource::CalcIslandMaxViolation(const IslandIterate& iterate) 
   const VecX& x = iterate.x(iterate.IndexOf(&body_));
   double violation = 0.0;
   for (const ContactPoint& point : points_)
-    if (Moves(point)) violation = std::max(violation, -CalcPointGap(iterate, CalcContactPointPosition(point, x)));
+    if (Moves(point))
+      violation = std::max(violation, -CalcPointGap(iterate, CalcContactPointPosition(point, x)));
   return violation;
 }
 
@@ -131,7 +127,8 @@ double RigidContactSource::CalcIslandViolationSum(const IslandIterate& iterate) 
   const VecX& x = iterate.x(iterate.IndexOf(&body_));
   double sum = 0.0;
   for (const ContactPoint& point : points_)
-    if (Moves(point)) sum += std::max(0.0, -CalcPointGap(iterate, CalcContactPointPosition(point, x)));
+    if (Moves(point))
+      sum += std::max(0.0, -CalcPointGap(iterate, CalcContactPointPosition(point, x)));
   return sum;
 }
 

@@ -84,7 +84,8 @@ void RigidIslandBody::ApplySystemMatrix(const VecX& v, VecX& out) const {
 
 double RigidIslandBody::CalcBlockMobility(int i, const Vec3& J) const {
   // J^T A^+ J of one block, as SolveSystemColumns applies A^+ (axis factors included).
-  if (i == 0) return J.dot((ToEigen(body_->getLinearFactor()) * body_->getInvMass()).cwiseProduct(J));
+  if (i == 0)
+    return J.dot((ToEigen(body_->getLinearFactor()) * body_->getInvMass()).cwiseProduct(J));
   const Vec3 torque = ToEigen(body_->getAngularFactor()).cwiseProduct(J);
   return torque.dot(inverse_inertia_ * torque);
 }

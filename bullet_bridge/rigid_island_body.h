@@ -63,7 +63,7 @@ class RigidIslandBody final : public IslandBody {
   Mat3 inverse_inertia_;  // world frame, step start
   Mat3 inertia_;          // its pseudo-inverse
   Eigen::Matrix<double, 6, 6> newton_added_ = Eigen::Matrix<double, 6, 6>::Zero();
-  Eigen::Matrix<double, 6, 6> mobility_;  // A^+ with the axis factors
+  Eigen::Matrix<double, 6, 6> mobility_;                        // A^+ with the axis factors
   Eigen::PartialPivLU<Eigen::Matrix<double, 6, 6>> newton_lu_;  // of I + A^+ B
 };
 

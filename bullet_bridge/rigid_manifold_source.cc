@@ -43,16 +43,17 @@ void RigidManifoldSource::AddManifold(const btPersistentManifold& manifold,
     p.distance = static_cast<double>(point.getDistance());
     p.friction = static_cast<double>(point.m_combinedFriction);
     // Approach speed at v* (Bullet's solver also measures it after external impulses).
-    const Vec3 va = a != nullptr ? RigidIslandBody::CalcPointVelocity(a->v_star(), com_a + p.ra, com_a)
-                                 : Vec3::Zero();
-    const Vec3 vb = b != nullptr ? RigidIslandBody::CalcPointVelocity(b->v_star(), com_b + p.rb, com_b)
-                                 : Vec3::Zero();
+    const Vec3 va = a != nullptr
+                        ? RigidIslandBody::CalcPointVelocity(a->v_star(), com_a + p.ra, com_a)
+                        : Vec3::Zero();
+    const Vec3 vb = b != nullptr
+                        ? RigidIslandBody::CalcPointVelocity(b->v_star(), com_b + p.rb, com_b)
+                        : Vec3::Zero();
     const double approach = -p.normal.dot(va - vb);
     p.bounce = approach > static_cast<double>(info.m_restitutionVelocityThreshold)
                    ? static_cast<double>(point.m_combinedRestitution) * approach
                    : 0.0;
-    for (int k = 0; k < 3; ++k)
-      p.keys[k] = key_.Pack(ObjectId(object_a), ObjectId(object_b), i, k);
+    for (int k = 0; k < 3; ++k) p.keys[k] = key_.Pack(ObjectId(object_a), ObjectId(object_b), i, k);
     points_.push_back(p);
   }
 }

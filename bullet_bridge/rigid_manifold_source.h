@@ -18,12 +18,12 @@ namespace taut {
 struct RigidContactPoint {
   const RigidIslandBody* a = nullptr;  // null: immovable (static or kinematic)
   const RigidIslandBody* b = nullptr;
-  Vec3 ra, rb;       // contact points relative to the centres of mass [m]
-  Vec3 normal;       // from B to A (Bullet's normalWorldOnB)
-  Vec3 tangent[2];   // friction directions
-  double distance;   // signed separation at the step start [m], < 0 penetrating
-  double bounce;     // restitution target of the normal relative velocity [m/s], >= 0
-  double friction;   // combined Coulomb coefficient
+  Vec3 ra, rb;      // contact points relative to the centres of mass [m]
+  Vec3 normal;      // from B to A (Bullet's normalWorldOnB)
+  Vec3 tangent[2];  // friction directions
+  double distance;  // signed separation at the step start [m], < 0 penetrating
+  double bounce;    // restitution target of the normal relative velocity [m/s], >= 0
+  double friction;  // combined Coulomb coefficient
   std::array<std::uint64_t, 3> keys;  // identity for warm starting: normal, two friction rows
 };
 

@@ -44,10 +44,10 @@ struct ConstraintRow {
   // 0 for unilateral rows. A friction row targets J v = 0 within the Coulomb disk of radius
   // mu lambda_n; its C is unused.
   int friction_of = 0;
-  double mu = 0.0;  // Coulomb coefficient of a friction row
+  double mu = 0.0;                        // Coulomb coefficient of a friction row
   std::array<int, kMaxRowNodes> nodes{};  // node indices in the body
   std::array<Vec3, kMaxRowNodes> J{};     // dC/dx_node
-  int body2 = -1;                          // side B's body in the island, -1 when one-sided
+  int body2 = -1;                         // side B's body in the island, -1 when one-sided
   int num_nodes2 = 0;
   std::array<int, kMaxRowNodes> nodes2{};
   std::array<Vec3, kMaxRowNodes> J2{};
@@ -67,8 +67,8 @@ struct ConstraintRow {
   }
 };
 
-// Two unit tangents t1, t2 completing the unit normal n to a right-handed frame (n, t1, t2 = n x t1):
-// the friction directions of a contact (docs/math.md §5.5).
+// Two unit tangents t1, t2 completing the unit normal n to a right-handed frame (n, t1, t2 = n x
+// t1): the friction directions of a contact (docs/math.md §5.5).
 inline void CalcContactTangents(const Vec3& n, Vec3& t1, Vec3& t2) {
   t1 = (std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized();
   t2 = n.cross(t1);

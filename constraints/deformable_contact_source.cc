@@ -60,8 +60,8 @@ DeformableContactSource::DeformableContactSource(const DeformableBody& a,
       friction_(friction),
       margin_(margin) {
   TAUT_DEMAND(&a != &b, "body '", a.name(), "': deformable contact needs two different bodies");
-  TAUT_DEMAND(std::isfinite(friction) && friction >= 0.0, "bodies '", a.name(), "' and '",
-              b.name(), "': contact friction must be finite and >= 0, got ", friction);
+  TAUT_DEMAND(std::isfinite(friction) && friction >= 0.0, "bodies '", a.name(), "' and '", b.name(),
+              "': contact friction must be finite and >= 0, got ", friction);
   TAUT_DEMAND(std::isfinite(margin) && margin > 0.0, "bodies '", a.name(), "' and '", b.name(),
               "': contact margin must be finite and > 0 m, got ", margin);
 }

@@ -23,9 +23,7 @@ class DeformableIslandBody final : public IslandBody {
   }
   bool is_free_block(int i) const override { return body_->node_kind(i) == NodeKind::kFree; }
   // x = x0 + h v (docs/math.md §5.1: positions of the backward-Euler step).
-  void CalcPositions(double h, const VecX& v, VecX& x) const override {
-    x = body_->x0() + h * v;
-  }
+  void CalcPositions(double h, const VecX& v, VecX& x) const override { x = body_->x0() + h * v; }
   const DeformableBody* deformable() const override { return body_; }
   double CalcBlockMobility(int i, const Vec3& J) const override {
     return is_free_block(i) ? J.squaredNorm() / body_->mass()[i] : 0.0;
@@ -37,7 +35,9 @@ class DeformableIslandBody final : public IslandBody {
   }
   void FactorNewtonMatrix() override { body_->mutable_system().FactorNewtonMatrix(body_->name()); }
   void SolveNewton(Eigen::Ref<VecX> rhs) const override { body_->system().SolveNewton(rhs); }
-  double CalcNewtonRefactorCost() const override { return body_->system().CalcNewtonRefactorCost(); }
+  double CalcNewtonRefactorCost() const override {
+    return body_->system().CalcNewtonRefactorCost();
+  }
   void ApplyNewtonMatrix(const VecX& v, VecX& out) const override {
     body_->system().MultiplyNewton(v, out);
   }

@@ -48,8 +48,8 @@ void IslandRows::Store(const VecX& lambda, KeyedMultipliers& to) const {
 
 void IslandRows::CountTypes(StepStats& stats) const {
   auto count = [this](RowType type) {
-    return static_cast<int>(
-        std::count_if(rows_.begin(), rows_.end(), [type](const auto& r) { return r.type == type; }));
+    return static_cast<int>(std::count_if(rows_.begin(), rows_.end(),
+                                          [type](const auto& r) { return r.type == type; }));
   };
   stats.rows_strain = count(RowType::kStrainLimit);
   stats.rows_energy = count(RowType::kEnergyLimit);

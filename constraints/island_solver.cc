@@ -6,9 +6,12 @@ namespace taut {
 
 const char* GetIslandSolverName(IslandSolverKind kind) {
   switch (kind) {
-    case IslandSolverKind::kAuto: return "auto";
-    case IslandSolverKind::kDual: return "dual";
-    case IslandSolverKind::kPrimal: return "primal";
+    case IslandSolverKind::kAuto:
+      return "auto";
+    case IslandSolverKind::kDual:
+      return "dual";
+    case IslandSolverKind::kPrimal:
+      return "primal";
   }
   return "unknown";
 }
@@ -19,8 +22,8 @@ IslandSolverKind IslandSolver::ChooseAuto(int rows, int free_dofs, int primal_st
 }
 
 void IslandSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
-                         const std::vector<ConstraintSource*>& sources,
-                         const SqpSettings& settings, StepStats& stats) {
+                         const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
+                         StepStats& stats) {
   IslandSolverKind kind = settings.solver;
   if (kind == IslandSolverKind::kAuto) {
     int free_dofs = 0;

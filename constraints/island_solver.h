@@ -32,8 +32,8 @@ class IslandSolver {
  private:
   SqpSolver dual_;
   PrimalSolver primal_;
-  KeyedMultipliers warm_;  // last step's multipliers by key, whichever path ran
-  int last_rows_ = 0;      // rows at the end of the last step
+  KeyedMultipliers warm_;      // last step's multipliers by key, whichever path ran
+  int last_rows_ = 0;          // rows at the end of the last step
   int primal_steps_left_ = 0;  // > 0: the dual path failed recently, stay primal
 };
 

@@ -77,8 +77,8 @@ KktResiduals CalcKktResiduals(const std::vector<IslandBody*>& bodies, const Isla
       const double norm_t = std::hypot(lambda[first], lambda[first + 1]);
       if (row.friction_of == 1) dual = std::max(dual, norm_t - radius);
       if (norm_t < radius * (1.0 - 1e-6) - active)
-        kkt.complementarity[type] = std::max(
-            kkt.complementarity[type], h * std::abs(rows.CalcRowVelocity(c, v)) * scale);
+        kkt.complementarity[type] =
+            std::max(kkt.complementarity[type], h * std::abs(rows.CalcRowVelocity(c, v)) * scale);
     } else if (row.bilateral) {
       dual = std::max({dual, row.lo - lambda[c], lambda[c] - row.hi});
     } else {

@@ -25,7 +25,7 @@ struct Sweep {
   const std::vector<PgsRow>& rows;
   Eigen::Ref<VecX>& lambda;
   double omega;
-  double threshold;  // rows with W_cc <= threshold are skipped
+  double threshold;   // rows with W_cc <= threshold are skipped
   VecX* w = nullptr;  // optional w = W lambda + q kept current: O(m) per changed row, O(1) else
   double delta = 0.0;
 

@@ -113,8 +113,8 @@ void PrimalSolver::LinearizeRows(double h, const std::vector<IslandBody*>& bodie
     g0_[c] = row.friction_of > 0 ? 0.0 : row.C / h - rows_.CalcRowVelocity(c, v_);
     // Rows of one element are adjacent and share its nodes: the previous row's answer holds.
     const ConstraintRow* previous = c > 0 ? &rows_[c - 1] : nullptr;
-    const bool same_nodes = previous && previous->body == row.body && previous->body2 == row.body2 &&
-                            previous->num_nodes == row.num_nodes &&
+    const bool same_nodes = previous && previous->body == row.body &&
+                            previous->body2 == row.body2 && previous->num_nodes == row.num_nodes &&
                             previous->num_nodes2 == row.num_nodes2 &&
                             previous->nodes == row.nodes && previous->nodes2 == row.nodes2;
     if (same_nodes) {
@@ -131,7 +131,8 @@ void PrimalSolver::LinearizeRows(double h, const std::vector<IslandBody*>& bodie
   }
   // A friction pair is held on the pattern only as a whole (its D couples the two rows).
   for (int c = 0; c < m; ++c)
-    if (rows_[c].friction_of == 1) in_pattern_[c] = in_pattern_[c + 1] = in_pattern_[c] && in_pattern_[c + 1];
+    if (rows_[c].friction_of == 1)
+      in_pattern_[c] = in_pattern_[c + 1] = in_pattern_[c] && in_pattern_[c + 1];
 }
 
 void PrimalSolver::CollectCurvature(double h, const std::vector<IslandBody*>& bodies,
@@ -272,7 +273,8 @@ int PrimalSolver::AssembleNewtonMatrices(const std::vector<IslandBody*>& bodies)
 void PrimalSolver::RowGroup::Clear() { num_nodes = 0; }
 
 bool PrimalSolver::RowGroup::Matches(const ConstraintRow& row) const {
-  if (num_nodes == 0 || row.body != body || row.num_nodes + row.num_nodes2 != num_nodes) return false;
+  if (num_nodes == 0 || row.body != body || row.num_nodes + row.num_nodes2 != num_nodes)
+    return false;
   for (int n = 0; n < row.num_nodes; ++n)
     if (row.nodes[n] != nodes[n]) return false;
   for (int n = 0; n < row.num_nodes2; ++n)
@@ -407,8 +409,7 @@ void PrimalSolver::CalcSlope(double alpha, double a0, double a1, double& slope,
 double PrimalSolver::SearchModelLine(const std::vector<IslandBody*>& bodies) {
   const size_t nb = bodies.size();
   // a0 = d^T A(v - v*), a1 = d^T (A + G) d, s_c = J_c d.
-  for (size_t b = 0; b < nb; ++b)
-    bodies[b]->ApplySystemMatrix(v_[b] - bodies[b]->v_star(), hp_[b]);
+  for (size_t b = 0; b < nb; ++b) bodies[b]->ApplySystemMatrix(v_[b] - bodies[b]->v_star(), hp_[b]);
   const double a0 = Dot(d_, hp_);
   for (size_t b = 0; b < nb; ++b) bodies[b]->ApplySystemMatrix(d_[b], hp_[b]);
   AddCurvatureTimes(d_, hp_);
@@ -430,7 +431,10 @@ double PrimalSolver::SearchModelLine(const std::vector<IslandBody*>& bodies) {
   double alpha = hi;
   for (int it = 0; it < 50; ++it) {
     if (std::abs(slope) <= 1e-12 * std::abs(slope0)) break;
-    if (slope > 0.0) hi = alpha; else lo = alpha;
+    if (slope > 0.0)
+      hi = alpha;
+    else
+      lo = alpha;
     double next = curvature > 0.0 ? alpha - slope / curvature : 0.5 * (lo + hi);
     if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
     alpha = next;
@@ -440,8 +444,7 @@ double PrimalSolver::SearchModelLine(const std::vector<IslandBody*>& bodies) {
   return alpha;
 }
 
-double PrimalSolver::CalcMerit(const std::vector<IslandBody*>& bodies,
-                               const std::vector<VecX>& v) {
+double PrimalSolver::CalcMerit(const std::vector<IslandBody*>& bodies, const std::vector<VecX>& v) {
   // Phi = 1/2 ||v - v*||_A^2 + sum_c P_c(y_c) / rho_c with g_c = C_c/h (friction: J_t v).
   double phi = 0.0;
   for (size_t b = 0; b < bodies.size(); ++b) {
@@ -493,8 +496,10 @@ bool PrimalSolver::TakeNewtonStep(double h, const std::vector<IslandBody*>& bodi
   const size_t nb = bodies.size();
   CalcProjectedMultipliers();
   CalcGradient(bodies);
-  if (primal.curvature) CollectCurvature(h, bodies, sources);
-  else curvature_.clear();
+  if (primal.curvature)
+    CollectCurvature(h, bodies, sources);
+  else
+    curvature_.clear();
   ChooseFactorReuse(bodies, primal);
   stats.newton_factorizations += AssembleNewtonMatrices(bodies);
   stats.pcg_iterations += SolveNewtonStep(bodies, primal);
@@ -543,8 +548,8 @@ bool PrimalSolver::WarmStartVelocities(const std::vector<IslandBody*>& bodies) {
 }
 
 void PrimalSolver::ChooseStartVelocities(double h, const std::vector<IslandBody*>& bodies,
-                                          const std::vector<ConstraintSource*>& sources,
-                                          const SqpSettings& settings, StepStats& stats) {
+                                         const std::vector<ConstraintSource*>& sources,
+                                         const SqpSettings& settings, StepStats& stats) {
   // Candidates in order: v*, v* + A^-1 J^T lambda_bar, the step-start velocity (v* on pinned
   // blocks); the one of least Phi (with its rows) is the start. Rows are at v* on entry.
   double best = CalcMerit(bodies, v_);
@@ -571,8 +576,8 @@ void PrimalSolver::ChooseStartVelocities(double h, const std::vector<IslandBody*
 }
 
 void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
-                         const std::vector<ConstraintSource*>& sources,
-                         const SqpSettings& settings, KeyedMultipliers& warm, StepStats& stats) {
+                         const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
+                         KeyedMultipliers& warm, StepStats& stats) {
   const PrimalSettings& primal = settings.primal;
   const size_t nb = bodies.size();
   for (auto* list : {&v_, &v_trial_, &d_, &grad_, &work_, &r_, &z_, &p_, &hp_}) list->resize(nb);
@@ -597,7 +602,8 @@ void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     const KktResiduals kkt =
         CalcKktResiduals(bodies, rows_, lambda_bar_, v_, h, distance_scale, scratch_);
     RecordKkt(kkt, stats);
-    stats.converged = IsCertified(kkt, settings.violation_tolerance, settings.stationarity_tolerance);
+    stats.converged =
+        IsCertified(kkt, settings.violation_tolerance, settings.stationarity_tolerance);
     if (stats.converged || k >= primal.max_iterations) {
       stats.ms_solve += MsSince(t);
       break;

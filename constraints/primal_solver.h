@@ -25,7 +25,8 @@ namespace taut {
 //       d = -H^-1 grad; alpha from the exact line search of the linearized model, backtracked
 //       (Armijo) on the nonlinear Phi;
 //     then lambda_bar_c <- Proj_c(y_c(v)),
-//   until the KKT residuals at (v, lambda_bar) are within tolerance (constraints/kkt_certificate.h).
+//   until the KKT residuals at (v, lambda_bar) are within tolerance
+//   (constraints/kkt_certificate.h).
 // rho_c = penalty_scale / w_c with w_c = sum_i J_ci^T M_i^-1 J_ci (a diagonal Delassus estimate
 // from lumped masses; no W is formed), for limit rows kept by key within a multiplier iteration.
 // Rows local to one body (strain, energy, node contact) keep H on A's sparsity pattern: one
@@ -103,15 +104,15 @@ class PrimalSolver {
   VecX rho_, g0_, jv_, s_;     // penalties, g_c(v) = g0 + J v, J v, J d
   KeyedMultipliers kept_rho_;  // limit rows' rho of this multiplier iteration by key
   bool rho_kept_ = false;
-  VecX d_unit_;                // D_c of scalar rows (0 or 1)
+  VecX d_unit_;                          // D_c of scalar rows (0 or 1)
   std::vector<Eigen::Matrix2d> d_disk_;  // D of a friction pair, on its first tangent row
   std::vector<char> in_pattern_;         // row's same-body blocks fit the patterns
   bool coupled_ = false;                 // some row is two-sided or off-pattern: PCG
   std::vector<char> stale_;              // body keeps its last factor (ChooseFactorReuse)
   bool any_stale_ = false;
-  double stale_budget_ = 0.0;            // CG iterations a kept factor may take before a refactor
-  bool refactor_next_ = false;           // the last kept factor took too many: refactor
-  double violation_ = 0.0;               // largest row violation at the collected rows
+  double stale_budget_ = 0.0;   // CG iterations a kept factor may take before a refactor
+  bool refactor_next_ = false;  // the last kept factor took too many: refactor
+  double violation_ = 0.0;      // largest row violation at the collected rows
   struct CurvatureBlock {
     int body, a, b;
     Mat3 block;

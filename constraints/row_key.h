@@ -17,9 +17,7 @@ constexpr int kRowKeySourceBits = 16;   // source id: bits 48-63 of every key
 constexpr int kRowKeyPayloadBits = 48;  // the source's fields: bits 0-47
 
 // Source id of a row key.
-inline int RowKeySource(std::uint64_t key) {
-  return static_cast<int>(key >> kRowKeyPayloadBits);
-}
+inline int RowKeySource(std::uint64_t key) { return static_cast<int>(key >> kRowKeyPayloadBits); }
 
 // The bits of a row key below the source id: the source's packed fields.
 inline std::uint64_t RowKeyPayload(std::uint64_t key) {

@@ -9,54 +9,68 @@
 namespace taut {
 
 // StrainLimitConstraint: a row per element, limit axis, matched principal axis and bound.
-inline constexpr RowKeyLayout<4> kStrainLimitRowKey{"strain limits", {{
-    {"element", 31},         // element index (any int >= 0)
-    {"axis", 2},             // limit axis j, 0-2
-    {"principal axis", 2},   // matched material axis m = pi(i), 0-2
-    {"bound", 1},            // StrainBound: 0 min, 1 max
-}}};
+inline constexpr RowKeyLayout<4> kStrainLimitRowKey{
+    "strain limits",
+    {{
+        {"element", 31},        // element index (any int >= 0)
+        {"axis", 2},            // limit axis j, 0-2
+        {"principal axis", 2},  // matched material axis m = pi(i), 0-2
+        {"bound", 1},           // StrainBound: 0 min, 1 max
+    }}};
 
 // EnergyLimitConstraint: a row per element (the element in the low bits: key = source | element).
-inline constexpr RowKeyLayout<1> kEnergyLimitRowKey{"energy limits", {{
-    {"element", 31},  // element index (any int >= 0)
-}}};
+inline constexpr RowKeyLayout<1> kEnergyLimitRowKey{
+    "energy limits",
+    {{
+        {"element", 31},  // element index (any int >= 0)
+    }}};
 
 // DeformableContactSource: a contact point of one body against a surface triangle of the other.
-inline constexpr RowKeyLayout<4> kDeformableContactRowKey{"deformable contact", {{
-    {"direction", 1},  // 0: points of A against triangles of B; 1: the reverse
-    {"point", 22},     // contact point of the touching body, < 4,194,304
-    {"triangle", 23},  // surface triangle of the other body, < 8,388,608
-    {"row", 2},        // 0 normal, 1 and 2 the friction tangents
-}}};
+inline constexpr RowKeyLayout<4> kDeformableContactRowKey{
+    "deformable contact",
+    {{
+        {"direction", 1},  // 0: points of A against triangles of B; 1: the reverse
+        {"point", 22},     // contact point of the touching body, < 4,194,304
+        {"triangle", 23},  // surface triangle of the other body, < 8,388,608
+        {"row", 2},        // 0 normal, 1 and 2 the friction tangents
+    }}};
 
 // RigidContactSource: a contact point of a deformable against a rigid object.
-inline constexpr RowKeyLayout<4> kRigidContactRowKey{"rigid contact", {{
-    {"point", 22},          // contact point of the deformable, < 4,194,304
-    {"outside world", 1},   // 0: object keyed by its world index; 1: an object in no world,
-                            //    keyed by its position among the source's partners
-    {"object", 23},         // the world index (getWorldArrayIndex) or position, < 8,388,608
-    {"row", 2},             // 0 normal, 1 and 2 the friction tangents
-}}};
+inline constexpr RowKeyLayout<4> kRigidContactRowKey{
+    "rigid contact",
+    {{
+        {"point", 22},         // contact point of the deformable, < 4,194,304
+        {"outside world", 1},  // 0: object keyed by its world index; 1: an object in no world,
+                               //    keyed by its position among the source's partners
+        {"object", 23},        // the world index (getWorldArrayIndex) or position, < 8,388,608
+        {"row", 2},            // 0 normal, 1 and 2 the friction tangents
+    }}};
 
 // RigidManifoldSource: a point of Bullet's contact manifold between two rigid objects.
-inline constexpr RowKeyLayout<4> kRigidManifoldRowKey{"rigid manifold", {{
-    {"object a", 22},  // broadphase unique id of the manifold's body 0, < 4,194,304
-    {"object b", 22},  // broadphase unique id of the manifold's body 1, < 4,194,304
-    {"contact", 2},    // point index in the manifold (< MANIFOLD_CACHE_SIZE = 4)
-    {"row", 2},        // 0 normal, 1 and 2 the friction tangents
-}}};
+inline constexpr RowKeyLayout<4> kRigidManifoldRowKey{
+    "rigid manifold",
+    {{
+        {"object a", 22},  // broadphase unique id of the manifold's body 0, < 4,194,304
+        {"object b", 22},  // broadphase unique id of the manifold's body 1, < 4,194,304
+        {"contact", 2},    // point index in the manifold (< MANIFOLD_CACHE_SIZE = 4)
+        {"row", 2},        // 0 normal, 1 and 2 the friction tangents
+    }}};
 
 // JointSource: a row of a Bullet joint (btTypedConstraint::getInfo2).
-inline constexpr RowKeyLayout<2> kJointRowKey{"joints", {{
-    {"joint", 31},  // the joint's user constraint id (0 when unset)
-    {"row", 17},    // the row's index among the island's joint rows of the step, < 131,072
-}}};
+inline constexpr RowKeyLayout<2> kJointRowKey{
+    "joints",
+    {{
+        {"joint", 31},  // the joint's user constraint id (0 when unset)
+        {"row", 17},    // the row's index among the island's joint rows of the step, < 131,072
+    }}};
 
 // NodeAttachmentSource: an attached node along one world axis.
-inline constexpr RowKeyLayout<2> kNodeAttachmentRowKey{"node attachment", {{
-    {"node", 31},  // position of the node in the attachment's node list
-    {"axis", 2},   // world axis 0-2
-}}};
+inline constexpr RowKeyLayout<2> kNodeAttachmentRowKey{
+    "node attachment",
+    {{
+        {"node", 31},  // position of the node in the attachment's node list
+        {"axis", 2},   // world axis 0-2
+    }}};
 
 static_assert(kStrainLimitRowKey.bits() <= kRowKeyPayloadBits, "strain-limit key too wide");
 static_assert(kEnergyLimitRowKey.bits() <= kRowKeyPayloadBits, "energy-limit key too wide");

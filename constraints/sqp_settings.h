@@ -18,13 +18,13 @@ const char* GetIslandSolverName(IslandSolverKind kind);
 
 // The primal path (constraints/primal_solver.h).
 struct PrimalSettings {
-  int max_iterations = 40;          // SQP (multiplier) iterations per step (cap)
-  int max_newton_iterations = 12;   // Newton iterations per linearized problem (cap)
-  double penalty_scale = 1e3;       // rho_c w_c: penalty over the row's diagonal compliance
-  double newton_tolerance = 1e-9;   // stop when the Newton decrement < this * ||v - v*||_A^2
-  int max_pcg_iterations = 200;     // coupled islands: PCG on the Newton step
-  double pcg_tolerance = 1e-10;     // relative residual of that PCG
-  bool curvature = true;            // lagged row curvature G in the model and H
+  int max_iterations = 40;         // SQP (multiplier) iterations per step (cap)
+  int max_newton_iterations = 12;  // Newton iterations per linearized problem (cap)
+  double penalty_scale = 1e3;      // rho_c w_c: penalty over the row's diagonal compliance
+  double newton_tolerance = 1e-9;  // stop when the Newton decrement < this * ||v - v*||_A^2
+  int max_pcg_iterations = 200;    // coupled islands: PCG on the Newton step
+  double pcg_tolerance = 1e-10;    // relative residual of that PCG
+  bool curvature = true;           // lagged row curvature G in the model and H
   // Factor reuse: a body whose H costs more than min_refactor_cost preconditioned CG iterations
   // to factor keeps its last factor (from an earlier Newton iteration or step) as the
   // preconditioner of CG on the exact H, to stale_pcg_tolerance, while CG needs fewer than half
@@ -44,18 +44,18 @@ inline PgsSettings DefaultPgs() {
 
 // Solver settings (defaults suit interactive use; the report sweeps them).
 struct SqpSettings {
-  int max_iterations = 10;           // SQP iterations per step (cap), before restoration
-  double violation_tolerance = 1e-3; // stop when max(0, -C) <= this (C is a fraction of the limit)
-  double contact_tolerance = 1e-5;   // [m] the same for contact and joint rows, whose C is a
-                                     // distance (rigid contacts: h times a velocity error)
+  int max_iterations = 10;            // SQP iterations per step (cap), before restoration
+  double violation_tolerance = 1e-3;  // stop when max(0, -C) <= this (C is a fraction of the limit)
+  double contact_tolerance = 1e-5;    // [m] the same for contact and joint rows, whose C is a
+                                      // distance (rigid contacts: h times a velocity error)
   double stationarity_tolerance = 1e-2;  // ... and the relative stationarity (kkt_certificate.h)
-  int max_restoration_iterations = 10;  // push-only iterations after the cap while infeasible
-  int max_line_search_halvings = 8;  // merit backtracking: alpha = 1, 1/2, ...
-  double stalled_step = 0.1;         // feasible and last alpha below this: stop (stalled)
-  PgsSettings pgs = DefaultPgs();     // sweeps and tolerance of each QP
-  bool polish_active_set = true;     // refine an unconverged PGS answer by active-set solves
+  int max_restoration_iterations = 10;   // push-only iterations after the cap while infeasible
+  int max_line_search_halvings = 8;      // merit backtracking: alpha = 1, 1/2, ...
+  double stalled_step = 0.1;             // feasible and last alpha below this: stop (stalled)
+  PgsSettings pgs = DefaultPgs();        // sweeps and tolerance of each QP
+  bool polish_active_set = true;         // refine an unconverged PGS answer by active-set solves
   ActiveSetPolishSettings polish;
-  bool warm_start = true;            // warm-start lambda from the previous step by row key
+  bool warm_start = true;  // warm-start lambda from the previous step by row key
   // Which island solver runs (constraints/island_solver.h) and the primal path's settings.
   IslandSolverKind solver = IslandSolverKind::kAuto;
   PrimalSettings primal;

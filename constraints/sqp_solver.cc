@@ -1,13 +1,13 @@
 #include "constraints/sqp_solver.h"
 
-#include "constraints/active_set_polish.h"
-#include "constraints/deformable_island_body.h"
-#include "constraints/kkt_certificate.h"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
+
+#include "constraints/active_set_polish.h"
+#include "constraints/deformable_island_body.h"
+#include "constraints/kkt_certificate.h"
 
 namespace taut {
 
@@ -152,8 +152,8 @@ void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     const bool feasible = violation <= settings.violation_tolerance;
     stats.converged =
         IsCertified(kkt, settings.violation_tolerance, settings.stationarity_tolerance);
-    if (feasible && (restoring || stationarity <= settings.stationarity_tolerance ||
-                     force_free || last_alpha < settings.stalled_step)) {
+    if (feasible && (restoring || stationarity <= settings.stationarity_tolerance || force_free ||
+                     last_alpha < settings.stalled_step)) {
       break;
     }
     if (k >= settings.max_iterations) {
@@ -171,8 +171,8 @@ void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
       const ConstraintRow& row = rows_[c];
       double jdv = 0.0;
       row.ForEachEntry([&](int body, int block, const Vec3& J) {
-        jdv += J.dot(bodies[body]->v_star().segment<3>(3 * block) -
-                     v_k_[body].segment<3>(3 * block));
+        jdv +=
+            J.dot(bodies[body]->v_star().segment<3>(3 * block) - v_k_[body].segment<3>(3 * block));
       });
       q_[c] = restoring ? row.C / h : row.C / h + jdv;
       // Friction rows: w_t = J_t v = J_t (v* + Y lambda), so q = J_t v* (restoration: 0).

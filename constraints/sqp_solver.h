@@ -4,22 +4,22 @@
 
 #include <vector>
 
+#include "constraints/active_set_polish.h"
 #include "constraints/constraint_row.h"
 #include "constraints/island_body.h"
-#include "constraints/active_set_polish.h"
+#include "constraints/island_rows.h"
 #include "constraints/pgs_solver.h"
 #include "constraints/sqp_settings.h"
 #include "constraints/step_stats.h"
-#include "constraints/island_rows.h"
 
 namespace taut {
 
 // Solves min 1/2 (v - v*)^T A (v - v*) s.t. C(x0 + h v) >= 0 for the bodies of one island:
 //   for k = 0, 1, ...: rows and J_k at x_k = x0 + h v_k; W = J_k A^-1 J_k^T;
-//   q = C(x_k)/h + J_k (v* - v_k); PGS from lambda_k -> lambda_QP; v_QP = v* + A^-1 J_k^T lambda_QP;
-//   alpha halved while phi(v_k + alpha (v_QP - v_k)) > phi(v_k) - 1e-4 alpha ||v_QP - v_k||_A^2,
-//   phi(v) = 1/2 ||v - v*||_A^2 + rho sum max(0, -C)/h, rho >= 2 max lambda (non-decreasing);
-//   v, lambda <- v_k + alpha (QP - k).
+//   q = C(x_k)/h + J_k (v* - v_k); PGS from lambda_k -> lambda_QP; v_QP = v* + A^-1 J_k^T
+//   lambda_QP; alpha halved while phi(v_k + alpha (v_QP - v_k)) > phi(v_k) - 1e-4 alpha ||v_QP -
+//   v_k||_A^2, phi(v) = 1/2 ||v - v*||_A^2 + rho sum max(0, -C)/h, rho >= 2 max lambda
+//   (non-decreasing); v, lambda <- v_k + alpha (QP - k).
 // Bilateral rows (joints, attachments) enter with a free multiplier and violation |C|.
 // Bodies enter with v = v* (after BeginStep) and leave with the constrained v.
 class SqpSolver {
@@ -53,13 +53,13 @@ class SqpSolver {
 
   IslandRows rows_;
   std::vector<PgsRow> pgs_rows_;
-  std::vector<MatX> Y_;                      // (num_bodies) 3N x rows of the body
-  std::vector<VecX> x_;                      // (num_bodies) positions at a trial velocity
+  std::vector<MatX> Y_;  // (num_bodies) 3N x rows of the body
+  std::vector<VecX> x_;  // (num_bodies) positions at a trial velocity
   MatX W_;
   VecX q_, lambda_, lambda_qp_, w_;
   Eigen::RowVectorXd w_row_;  // one row of W being assembled
   std::vector<VecX> v_k_, v_qp_, v_trial_, dv_;
-  VecX scratch_, jt_;  // 3N work vectors (A dv, J^T lambda), reused across steps
+  VecX scratch_, jt_;          // 3N work vectors (A dv, J^T lambda), reused across steps
   KeyedMultipliers previous_;  // last step's multipliers by key
   KeyedMultipliers iterate_;   // this step's lambda_k by key
 };

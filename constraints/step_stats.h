@@ -27,24 +27,24 @@ struct StepStats {
   double ms_stage_end_steps = 0.0;      // 7: x = x0 + h v (= ms_integrate)
 
   // Constraint work.
-  int rows_strain = 0;            // active strain-limit rows (last SQP iteration)
-  int rows_energy = 0;            // active energy-limit rows
-  int rows_contact = 0;           // deformable contact normal + friction rows
-  int rows_rigid_contact = 0;     // Bullet rigid-rigid contact rows inside deformable islands
-  int rows_joint = 0;             // Bullet joint and node attachment rows (bilateral)
-  int pgs_sweeps = 0;             // total over SQP iterations
-  int active_set_solves = 0;      // QPs refined by a direct active-set solve
-  int sqp_iterations = 0;         // including restoration iterations
-  int restoration_iterations = 0; // push-only iterations after the SQP cap
+  int rows_strain = 0;             // active strain-limit rows (last SQP iteration)
+  int rows_energy = 0;             // active energy-limit rows
+  int rows_contact = 0;            // deformable contact normal + friction rows
+  int rows_rigid_contact = 0;      // Bullet rigid-rigid contact rows inside deformable islands
+  int rows_joint = 0;              // Bullet joint and node attachment rows (bilateral)
+  int pgs_sweeps = 0;              // total over SQP iterations
+  int active_set_solves = 0;       // QPs refined by a direct active-set solve
+  int sqp_iterations = 0;          // including restoration iterations
+  int restoration_iterations = 0;  // push-only iterations after the SQP cap
   // Violations in units of the limit rows' C (fraction of the limit): max(0, -C) of limit rows,
   // and of contact/joint rows (C in m) times violation_tolerance / contact_tolerance.
   double violation_before = 0.0;  // at the unconstrained prediction x*
   double violation_after = 0.0;   // at the end of the step
-  double stationarity = 0.0;      // relative ||A(v - v*) - J^T lambda|| at the end (kkt_certificate.h)
+  double stationarity = 0.0;  // relative ||A(v - v*) - J^T lambda|| at the end (kkt_certificate.h)
   // Natural-map residual ||lambda - Proj_K(lambda - w)||_inf of the last QP at exit (PGS, after
   // any projected-Newton polish; docs/math.md §5.7) [units of lambda and w].
   double lcp_residual = 0.0;
-  bool converged = true;          // every KKT residual below within tolerance at the end
+  bool converged = true;  // every KKT residual below within tolerance at the end
 
   // Which island solver ran (constraints/island_solver.h): the papers' dual PGS path, the primal
   // augmented-Lagrangian Newton path, or none (no rows). With several islands: the count of each.
@@ -62,8 +62,8 @@ struct StepStats {
   double kkt_primal_by_type[5] = {0, 0, 0, 0, 0};
   double kkt_complementarity_by_type[5] = {0, 0, 0, 0, 0};
 
-  int islands = 0;                // islands solved by the SQP (with at least one row source)
-  int rigid_bodies_coupled = 0;   // dynamic rigid bodies solved inside deformable islands
+  int islands = 0;               // islands solved by the SQP (with at least one row source)
+  int rigid_bodies_coupled = 0;  // dynamic rigid bodies solved inside deformable islands
   // World substeps these figures cover: 1 for one substep, their count in the totals of a whole
   // stepSimulation call (AddSubstepStats, DeformableWorld::last_call_stats).
   int substeps = 1;

@@ -20,10 +20,7 @@ const TetElementModel& AsTets(const DeformableBody& body) {
 
 StrainLimitConstraint::StrainLimitConstraint(const DeformableBody& body,
                                              const StrainLimitSettings& settings, int source_id)
-    : body_(body),
-      tets_(AsTets(body)),
-      settings_(settings),
-      key_(kStrainLimitRowKey, source_id) {
+    : body_(body), tets_(AsTets(body)), settings_(settings), key_(kStrainLimitRowKey, source_id) {
   settings_.Validate(tets_.num_elements(), "body '" + body.name() + "' strain limits");
   params_ = CalcStrainLimitParams(settings_);
   // Hyperbolic and ellipsoid rows of principal axis i have C = 1 - kappa_eff (s_i - 1) with
@@ -91,7 +88,8 @@ void StrainLimitConstraint::AddIslandCurvature(const IslandIterate& iterate,
   SignedSvd svd;
   Mat12 sum = Mat12::Zero();
   const auto flush = [&] {
-    if (element >= 0) AddElementCurvatureBlocks<4>(sum, 1.0, body, tets_.element_nodes(element), sink);
+    if (element >= 0)
+      AddElementCurvatureBlocks<4>(sum, 1.0, body, tets_.element_nodes(element), sink);
   };
   for (int c = 0; c < count; ++c) {
     const ConstraintRow& row = rows[c];
@@ -106,8 +104,9 @@ void StrainLimitConstraint::AddIslandCurvature(const IslandIterate& iterate,
       svd = CalcSignedSvd(
           CalcTetDeformationGradient(r, tets_.GatherElement(iterate.x(row.body), element)));
     }
-    sum.noalias() += weights[c] * CalcStrainLimitRowCurvature(
-                                      r, svd, SelectStrainLimitFrame(settings_, element), params_, key);
+    sum.noalias() +=
+        weights[c] * CalcStrainLimitRowCurvature(r, svd, SelectStrainLimitFrame(settings_, element),
+                                                 params_, key);
   }
   flush();
 }

@@ -46,9 +46,9 @@ class StrainLimitConstraint final : public BodyConstraintSource {
   const TetElementModel& tets_;
   StrainLimitSettings settings_;
   StrainLimitParams params_;
-  RowKeyPacker<4> key_;  // kStrainLimitRowKey with this source's id
-  std::vector<StrainLimitRow> element_rows_;  // scratch, reused
-  bool screen_ = false;                       // IsSurelyInactive applies
+  RowKeyPacker<4> key_;                              // kStrainLimitRowKey with this source's id
+  std::vector<StrainLimitRow> element_rows_;         // scratch, reused
+  bool screen_ = false;                              // IsSurelyInactive applies
   double stretch_lo_ = 0.0, stretch_hi_ = HUGE_VAL;  // stretches that certainly emit no row
 };
 

@@ -1,7 +1,6 @@
 // taut-demo: runs one headless scene and writes DIR/summary.json, DIR/steps.csv and, with --vtk,
 // VTK frames for ParaView (docs/architecture.md §7).
 #include <CLI/CLI.hpp>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -40,7 +39,8 @@ int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::strin
   std::ofstream csv(out_dir + "/steps.csv");
   csv.precision(17);
   csv << "step,time_s,ms_step,ms_unconstrained,ms_rows,ms_solve,ms_rigid,rows_strain,"
-         "rows_energy,rows_contact,rows_rigid_contact,rows_joint,islands,rigid_bodies_coupled,pgs_sweeps,sqp_iterations,restoration_iterations,active_set_solves,"
+         "rows_energy,rows_contact,rows_rigid_contact,rows_joint,islands,rigid_bodies_coupled,pgs_"
+         "sweeps,sqp_iterations,restoration_iterations,active_set_solves,"
          "violation_before,violation_after,stationarity,converged,islands_dual,islands_primal,"
          "newton_iterations,pcg_iterations,kkt_primal,kkt_complementarity,kkt_dual";
   for (const std::string& column : scene->CsvColumns()) csv << "," << column;
@@ -54,7 +54,8 @@ int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::strin
   if (vtk) scene->WriteVtkFrame(out_dir, 0, 0.0);
   // Pictures (--png): snapshots are taken between the timed steps and rendered after the run.
   std::unique_ptr<taut::render::PictureRecorder> pictures;
-  if (png) pictures = std::make_unique<taut::render::PictureRecorder>(out_dir, info.name, steps, dt);
+  if (png)
+    pictures = std::make_unique<taut::render::PictureRecorder>(out_dir, info.name, steps, dt);
   if (pictures) pictures->Record(*scene, 0);
   for (int step = 1; step <= steps; ++step) {
     // Only the simulation is timed; the scene's own measurements follow the timer.
@@ -73,12 +74,12 @@ int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::strin
     csv << step << "," << step * dt << "," << ms << "," << s.ms_unconstrained << "," << s.ms_rows
         << "," << s.ms_solve << "," << s.ms_rigid << "," << s.rows_strain << "," << s.rows_energy
         << "," << s.rows_contact << "," << s.rows_rigid_contact << "," << s.rows_joint << ","
-        << s.islands << "," << s.rigid_bodies_coupled << "," << s.pgs_sweeps << "," << s.sqp_iterations << ","
-        << s.restoration_iterations << "," << s.active_set_solves << "," << s.violation_before
-        << "," << s.violation_after << "," << s.stationarity << "," << (s.converged ? 1 : 0) << ","
-        << s.islands_dual << "," << s.islands_primal << "," << s.newton_iterations << ","
-        << s.pcg_iterations << "," << s.kkt_primal << "," << s.kkt_complementarity << ","
-        << s.kkt_dual;
+        << s.islands << "," << s.rigid_bodies_coupled << "," << s.pgs_sweeps << ","
+        << s.sqp_iterations << "," << s.restoration_iterations << "," << s.active_set_solves << ","
+        << s.violation_before << "," << s.violation_after << "," << s.stationarity << ","
+        << (s.converged ? 1 : 0) << "," << s.islands_dual << "," << s.islands_primal << ","
+        << s.newton_iterations << "," << s.pcg_iterations << "," << s.kkt_primal << ","
+        << s.kkt_complementarity << "," << s.kkt_dual;
     values.clear();
     scene->AppendCsvValues(values);
     for (double v : values) csv << "," << v;
@@ -151,7 +152,8 @@ int main(int argc, char** argv) {
   app.add_option("--out", out_dir, "Output folder, created if missing (default: out/<scene>)");
   app.footer("Scenes:\n" + taut::FormatSceneList());
   app.add_flag("--vtk", vtk, "Write VTK frames of every deformable body");
-  app.add_option("--vtk-every", vtk_every, "Write a VTK frame every N steps")->check(CLI::PositiveNumber);
+  app.add_option("--vtk-every", vtk_every, "Write a VTK frame every N steps")
+      ->check(CLI::PositiveNumber);
   app.add_flag("--png", png,
                "Write pictures: the scene's key frames (key_*.png), figure.png and run.gif");
   const std::map<std::string, taut::IslandSolverKind> solvers = {

@@ -26,8 +26,8 @@ BoxGrid::BoxGrid(const std::vector<Eigen::AlignedBox3d>& boxes) {
   double edge_sum = 0.0;
   for (std::size_t b = 0; b < boxes.size(); ++b) {
     const Eigen::AlignedBox3d& box = boxes[b];
-    TAUT_DEMAND(!box.isEmpty() && box.min().allFinite() && box.max().allFinite(),
-                "BoxGrid: box ", b, " is empty or not finite");
+    TAUT_DEMAND(!box.isEmpty() && box.min().allFinite() && box.max().allFinite(), "BoxGrid: box ",
+                b, " is empty or not finite");
     bounds.extend(box);
     edge_sum += box.sizes().maxCoeff();
   }
@@ -38,8 +38,8 @@ BoxGrid::BoxGrid(const std::vector<Eigen::AlignedBox3d>& boxes) {
   const long long max_cells = 8 * static_cast<long long>(boxes.size()) + 64;
   dims_ = CalcGridDims(extent, edge_);
   while (CountCells(dims_) > max_cells) {
-    edge_ *= std::cbrt(static_cast<double>(CountCells(dims_)) / static_cast<double>(max_cells)) *
-             1.01;
+    edge_ *=
+        std::cbrt(static_cast<double>(CountCells(dims_)) / static_cast<double>(max_cells)) * 1.01;
     dims_ = CalcGridDims(extent, edge_);
   }
   origin_ = bounds.min();
@@ -53,12 +53,11 @@ BoxGrid::BoxGrid(const std::vector<Eigen::AlignedBox3d>& boxes) {
       const std::array<long long, 3> lo = CalcCellCoordinates(boxes[b].min());
       const std::array<long long, 3> hi = CalcCellCoordinates(boxes[b].max());
       for (long long k = std::max(lo[2], 0LL); k <= std::min<long long>(hi[2], dims_[2] - 1); ++k)
-        for (long long j = std::max(lo[1], 0LL); j <= std::min<long long>(hi[1], dims_[1] - 1);
-             ++j)
+        for (long long j = std::max(lo[1], 0LL); j <= std::min<long long>(hi[1], dims_[1] - 1); ++j)
           for (long long i = std::max(lo[0], 0LL); i <= std::min<long long>(hi[0], dims_[0] - 1);
                ++i) {
-            const int cell = CalcCellIndex(static_cast<int>(i), static_cast<int>(j),
-                                           static_cast<int>(k));
+            const int cell =
+                CalcCellIndex(static_cast<int>(i), static_cast<int>(j), static_cast<int>(k));
             if (pass == 0) {
               ++cell_start_[cell + 1];
             } else {
@@ -89,8 +88,8 @@ BoxGrid::Cell BoxGrid::FindCandidates(const Vec3& p) const {
   // Points on the grid's max faces belong to its last cells.
   std::array<long long, 3> ijk = CalcCellCoordinates(p);
   for (int d = 0; d < 3; ++d) ijk[d] = std::clamp<long long>(ijk[d], 0, dims_[d] - 1);
-  const int cell = CalcCellIndex(static_cast<int>(ijk[0]), static_cast<int>(ijk[1]),
-                                 static_cast<int>(ijk[2]));
+  const int cell =
+      CalcCellIndex(static_cast<int>(ijk[0]), static_cast<int>(ijk[1]), static_cast<int>(ijk[2]));
   const int* entries = box_of_entry_.data();
   return {entries + cell_start_[cell], entries + cell_start_[cell + 1]};
 }

@@ -33,10 +33,10 @@ class BoxGrid {
   std::array<long long, 3> CalcCellCoordinates(const Vec3& p) const;
   int CalcCellIndex(int i, int j, int k) const { return i + dims_[0] * (j + dims_[1] * k); }
 
-  Vec3 origin_ = Vec3::Zero();  // min corner of the bounds of all boxes
-  Vec3 max_ = Vec3::Zero();     // max corner of those bounds
-  double edge_ = 1.0;           // cell edge [m]
-  std::array<int, 3> dims_{};   // cells per axis
+  Vec3 origin_ = Vec3::Zero();     // min corner of the bounds of all boxes
+  Vec3 max_ = Vec3::Zero();        // max corner of those bounds
+  double edge_ = 1.0;              // cell edge [m]
+  std::array<int, 3> dims_{};      // cells per axis
   std::vector<int> cell_start_;    // (num_cells + 1) offsets into box_of_entry_
   std::vector<int> box_of_entry_;  // box indices, cell by cell
 };

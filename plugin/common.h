@@ -43,18 +43,18 @@ std::string Concat(const Args&... args) {
 }  // namespace taut
 
 // Always-on check of user input: throws taut::InputError with the streamed message.
-#define TAUT_DEMAND(cond, ...)                                          \
-  do {                                                                  \
+#define TAUT_DEMAND(cond, ...)                                                    \
+  do {                                                                            \
     if (!(cond)) throw ::taut::InputError(::taut::internal::Concat(__VA_ARGS__)); \
   } while (0)
 
 // Debug-only invariant check (internal logic, not user input).
 #ifndef NDEBUG
-#define TAUT_ASSERT(cond)                                                            \
-  do {                                                                               \
-    if (!(cond))                                                                     \
-      throw std::logic_error(::taut::internal::Concat(__FILE__, ":", __LINE__,       \
-                                                      ": assertion failed: " #cond)); \
+#define TAUT_ASSERT(cond)                                                                   \
+  do {                                                                                      \
+    if (!(cond))                                                                            \
+      throw std::logic_error(                                                               \
+          ::taut::internal::Concat(__FILE__, ":", __LINE__, ": assertion failed: " #cond)); \
   } while (0)
 #else
 #define TAUT_ASSERT(cond) \

@@ -51,7 +51,8 @@ ContactSurface MakeNodeSurface(const std::vector<Triangle>& faces) {
   for (const Triangle& face : faces) {
     Triangle t;
     for (int k = 0; k < 3; ++k) {
-      auto [it, inserted] = point_of_node.try_emplace(face[k], static_cast<int>(point_of_node.size()));
+      auto [it, inserted] =
+          point_of_node.try_emplace(face[k], static_cast<int>(point_of_node.size()));
       if (inserted) surface.points.push_back(NodePoint(face[k]));
       t[k] = it->second;
     }
@@ -108,8 +109,8 @@ ContactSurface MakeEmbeddedBodyContactSurface(const ElementModel& model,
     return MakeTetEmbeddedContactSurface(tets->mesh(), EmbedSurfaceInTets(tets->mesh(), surface));
   if (const auto* hexes = dynamic_cast<const HexElementModel*>(&model))
     return MakeEmbeddedContactSurface(hexes->lattice(), EmbedSurface(hexes->lattice(), surface));
-  throw InputError(internal::Concat(surface.source,
-                                    ": surfaces can only be embedded in tet or hex bodies"));
+  throw InputError(
+      internal::Concat(surface.source, ": surfaces can only be embedded in tet or hex bodies"));
 }
 
 std::vector<Vec3> CalcContactPointPositions(const ContactSurface& surface, const VecX& x) {
@@ -120,8 +121,7 @@ std::vector<Vec3> CalcContactPointPositions(const ContactSurface& surface, const
     const ContactPoint& p = surface.points[i];
     for (int k = 0; k < p.num_nodes; ++k)
       TAUT_DEMAND(p.nodes[k] >= 0 && p.nodes[k] < num_nodes, "surface point ", i,
-                  " refers to node ", p.nodes[k], " but there are ", num_nodes,
-                  " node positions");
+                  " refers to node ", p.nodes[k], " but there are ", num_nodes, " node positions");
     positions.push_back(CalcContactPointPosition(p, x));
   }
   return positions;

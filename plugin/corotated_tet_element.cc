@@ -76,8 +76,8 @@ Mat12 CalcExactTetStiffness(const TetRestElement& rest, const LameParameters& la
       const Mat3 dG = Vec3::Unit(k) * rest.r[m].transpose();
       const Mat3 RtdG = R.transpose() * dG;
       const Mat3 dR = R * Hat(T_inv * Vee(RtdG - RtdG.transpose()));
-      const Mat3 dP = 2.0 * lame.mu * (dG - dR) + lame.lambda * RtdG.trace() * R +
-                      lame.lambda * tr_eps * dR;
+      const Mat3 dP =
+          2.0 * lame.mu * (dG - dR) + lame.lambda * RtdG.trace() * R + lame.lambda * tr_eps * dR;
       for (int n = 0; n < 4; ++n) K.block<3, 1>(3 * n, 3 * m + k) = rest.volume * (dP * rest.r[n]);
     }
   }

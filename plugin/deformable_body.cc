@@ -205,9 +205,9 @@ void DeformableBody::CheckVelocities(const char* stage) {
     }
   }
   if (fastest >= 0)
-    FailStep(internal::Concat("node ", fastest, " moves at ",
-                              v_.segment<3>(3 * fastest).stableNorm(), " m/s, above max_speed = ",
-                              settings_.max_speed, " m/s (the step is exploding)"),
+    FailStep(internal::Concat(
+                 "node ", fastest, " moves at ", v_.segment<3>(3 * fastest).stableNorm(),
+                 " m/s, above max_speed = ", settings_.max_speed, " m/s (the step is exploding)"),
              stage);
 }
 

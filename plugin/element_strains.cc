@@ -20,8 +20,8 @@ ElementStrain MakeElementStrain(const Mat3& F, const Mat3& axes, double energy) 
 ElementStrain CalcTetStrain(const TetElementModel& tets, const VecX& x, int e, const Mat3& axes) {
   const TetRestElement& rest = tets.rest().elements[e];
   const Mat3 F = CalcTetDeformationGradient(rest, tets.GatherElement(x, e));
-  return MakeElementStrain(F, axes, CalcCorotatedTetEnergy(rest, tets.lame(), F,
-                                                           CalcPolarRotation(F)));
+  return MakeElementStrain(F, axes,
+                           CalcCorotatedTetEnergy(rest, tets.lame(), F, CalcPolarRotation(F)));
 }
 
 // Element e of a hex body at x.

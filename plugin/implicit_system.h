@@ -101,7 +101,8 @@ class ImplicitSystem {
   bool FactorWith(const Eigen::SparseMatrix<double>& M, SparseLdlt& ldlt,
                   CholmodCholesky& cholmod) const;
   // rhs (3N) <- M^-1 rhs on free DOFs with a factor of FactorWith; constrained DOFs set to 0.
-  void SolveWith(const SparseLdlt& ldlt, const CholmodCholesky& cholmod, Eigen::Ref<VecX> rhs) const;
+  void SolveWith(const SparseLdlt& ldlt, const CholmodCholesky& cholmod,
+                 Eigen::Ref<VecX> rhs) const;
   // out (3N) = M v on free DOFs, 0 on constrained DOFs.
   void MultiplyWith(const Eigen::SparseMatrix<double>& M, const VecX& v, VecX& out) const;
   // Value index of the first of the three rows of node a in column (free DOF) col, or -1.

@@ -77,8 +77,8 @@ SurfaceMesh MakeCylinderSurface(double length, double radius, int segments, int 
   for (int r = 0; r <= rings; ++r)
     for (int k = 0; k < segments; ++k) {
       const double phi = 2.0 * M_PI * k / segments;
-      mesh.vertices.push_back(axis_start + Vec3(length * r / rings, radius * std::cos(phi),
-                                                radius * std::sin(phi)));
+      mesh.vertices.push_back(
+          axis_start + Vec3(length * r / rings, radius * std::cos(phi), radius * std::sin(phi)));
     }
   const int start_cap = static_cast<int>(mesh.vertices.size());
   mesh.vertices.push_back(axis_start);

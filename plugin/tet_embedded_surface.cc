@@ -63,9 +63,9 @@ double CalcPointTetDistance(const TetMesh& mesh, int tet, const std::array<doubl
   for (int a = 0; a < 4; ++a) {
     if (w[a] >= 0.0) continue;
     const auto& f = kOpposite[a];
-    distance = std::min(distance, CalcPointTriangleDistance(X, mesh.nodes[t[f[0]]],
-                                                            mesh.nodes[t[f[1]]],
-                                                            mesh.nodes[t[f[2]]]));
+    distance =
+        std::min(distance, CalcPointTriangleDistance(X, mesh.nodes[t[f[0]]], mesh.nodes[t[f[1]]],
+                                                     mesh.nodes[t[f[2]]]));
   }
   return distance == kInfinity ? 0.0 : distance;
 }
@@ -95,8 +95,7 @@ Placement PlaceVertex(const TetMesh& mesh, const std::vector<TetFrame>& frames,
       Placement candidate;
       candidate.tet = tet;
       candidate.weights = CalcBarycentricWeights(frames[tet], X);
-      candidate.min_weight =
-          *std::min_element(candidate.weights.begin(), candidate.weights.end());
+      candidate.min_weight = *std::min_element(candidate.weights.begin(), candidate.weights.end());
       const bool inside = candidate.min_weight >= -kInsideSlack;
       if (pass == 0 && !inside) continue;
       candidate.distance = inside ? 0.0 : CalcPointTetDistance(mesh, tet, candidate.weights, X);
@@ -195,9 +194,9 @@ std::vector<Vec3> CalcTetEmbeddedPositions(const TetEmbeddedSurface& surface, co
   std::vector<Vec3> positions(surface.vertices.size(), Vec3::Zero());
   for (std::size_t v = 0; v < surface.vertices.size(); ++v) {
     const TetEmbeddedVertex& ev = surface.vertices[v];
-    TAUT_DEMAND(ev.tet >= 0 && static_cast<std::size_t>(ev.tet) < mesh.tets.size(),
-                surface.source, ": vertex ", v, " refers to tet ", ev.tet, " but ", mesh.source,
-                " has ", mesh.tets.size());
+    TAUT_DEMAND(ev.tet >= 0 && static_cast<std::size_t>(ev.tet) < mesh.tets.size(), surface.source,
+                ": vertex ", v, " refers to tet ", ev.tet, " but ", mesh.source, " has ",
+                mesh.tets.size());
     for (int a = 0; a < 4; ++a) {
       const int n = mesh.tets[ev.tet][a];
       TAUT_DEMAND(n >= 0 && static_cast<std::size_t>(n) < num_nodes, mesh.source, ": element ",

@@ -34,8 +34,8 @@ void ValidateTetMesh(const TetMesh& mesh) {
     for (int a = 0; a < 4; ++a)
       for (int b = 0; b < a; ++b) longest = std::max(longest, (*p[a] - *p[b]).norm());
     const double scale = longest * longest * longest;
-    TAUT_DEMAND(std::abs(volume) > 1e-12 * scale, src, ": element ", e,
-                " is degenerate (volume ", volume, " m^3, longest edge ", longest, " m)");
+    TAUT_DEMAND(std::abs(volume) > 1e-12 * scale, src, ": element ", e, " is degenerate (volume ",
+                volume, " m^3, longest edge ", longest, " m)");
     TAUT_DEMAND(volume > 0.0, src, ": element ", e, " is inverted (volume ", volume,
                 " m^3; expected det[X1-X4, X2-X4, X3-X4] > 0)");
   }

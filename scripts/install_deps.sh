@@ -29,6 +29,7 @@ PACKAGES=(
   gnuplot-nox
   clang
   libclang-rt-dev
+  clang-format
 )
 
 cd "$(dirname "${BASH_SOURCE[0]}")/.."

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# Builds and runs every check: (1) Release build + ctest, then a check that the default build
-# links no GPL library (scripts/check_licenses.sh), (2) install into build/stage and build and run
-# tests/consumer against the installed package, (3) Debug ASan/UBSan build + ctest, (4) a 10 s
+# Builds and runs every check: (1) Release build + ctest, then checks that the default build
+# links no GPL library (scripts/check_licenses.sh), that every docs/ citation exists
+# (scripts/check_citations.sh) and that the C++ files match .clang-format
+# (scripts/check_format.sh), (2) install into build/stage and build and run tests/consumer
+# against the installed package, (3) Debug ASan/UBSan build + ctest, (4) a 10 s
 # libFuzzer run of every mesh reader, (5) the opt-in CHOLMOD build (-DTAUT_WITH_CHOLMOD=ON,
 # build/cholmod, test binary only) and its solver tests.
 #   scripts/run_tests.sh [--quick | --sanitize-only]
@@ -24,7 +26,7 @@ for arg in "$@"; do
       run_consumer=0
       ;;
     -h | --help)
-      sed -n '2,9p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
+      sed -n '2,11p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
       exit 0
       ;;
     *)
@@ -59,6 +61,11 @@ stage_licenses() {
 # design notes kept outside the repository (scripts/check_citations.sh; needs no build).
 stage_citations() {
   bash scripts/check_citations.sh
+}
+
+# Stage 1d: every tracked C++ file is formatted by the repository's .clang-format.
+stage_format() {
+  bash scripts/check_format.sh
 }
 
 # Stage 5: the opt-in CHOLMOD build's solver tests (CHOLMOD itself, backend choice, FEM steps).
@@ -158,6 +165,7 @@ current=""
 if ((run_release)); then run_stage release; fi
 if ((run_release)); then run_stage licenses; fi
 if ((run_release)); then run_stage citations; fi
+if ((run_release)); then run_stage format; fi
 if ((run_consumer)); then run_stage consumer; fi
 if ((run_asan)); then run_stage asan; fi
 if ((run_asan)); then run_stage fuzz; fi

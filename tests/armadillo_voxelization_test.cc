@@ -50,8 +50,7 @@ namespace {
 TEST(ArmadilloSceneTest, LimitedArmadilloLandsAndItsEnergyLimitHolds) {
   if (!std::filesystem::exists(std::string(TAUT_DATA_DIR) + "/armadillo.off"))
     GTEST_SKIP() << "data/armadillo.off missing: run scripts/fetch_armadillo.sh";
-  ArmadilloScene scene({{"limited", 500e3, 100.0}},
-                       std::string(TAUT_DATA_DIR) + "/armadillo.off");
+  ArmadilloScene scene({{"limited", 500e3, 100.0}}, std::string(TAUT_DATA_DIR) + "/armadillo.off");
   for (int step = 0; step < 120; ++step) scene.Step(1.0 / 240.0);
   std::printf("armadillo: deepest %.2e m, flattening %.3f, U/Umax %.5f, contact rows %d\n",
               scene.deepest(0), scene.max_flattening(0), scene.max_energy_ratio(0),

@@ -1,8 +1,8 @@
 // The box_on_sphere scene: a three-box rigid stack on a soft energy-limited sphere stays stacked
 // and upright, with rigid-rigid rows solved inside the sphere's island.
-#include <gtest/gtest.h>
-
 #include "demos/scenes/box_on_sphere_scene.h"
+
+#include <gtest/gtest.h>
 
 namespace taut {
 namespace {
@@ -21,7 +21,7 @@ TEST(BoxOnSphereSceneTest, StackRestsOnTheLimitedSphereUprightAndInContact) {
   for (double gap : figures["box_gaps_m"]) EXPECT_NEAR(gap, 0.0, 5e-3);  // stacked, touching
   EXPECT_LT(scene.max_penetration(), 5e-3);
   EXPECT_LT(scene.max_energy_ratio(), 1.01);
-  EXPECT_LT(scene.box_height(0), start0);            // the sphere gave way under the stack
+  EXPECT_LT(scene.box_height(0), start0);  // the sphere gave way under the stack
   EXPECT_GT(scene.CalcFlattening(), 0.002);
   // The energy limit is what holds the stack up: without it the sphere flattens more.
   BoxOnSphereScene unlimited(500e3, 0.0);

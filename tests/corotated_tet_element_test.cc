@@ -77,8 +77,8 @@ TEST(CorotatedTetElementTest, ExactStiffnessIsMinusForceDerivative) {
   std::mt19937 rng(4);
   for (int trial = 0; trial < 200; ++trial) {
     const auto x = RandomState(rng, X, trial % 4 == 0);
-    const MatX dfdx = CentralDifference([&](const VecX& p) { return Forces(rest, p); },
-                                        Flatten(x), 1e-6);
+    const MatX dfdx =
+        CentralDifference([&](const VecX& p) { return Forces(rest, p); }, Flatten(x), 1e-6);
     const Mat12 K = CalcExactTetStiffness(rest, kLame, x);
     ASSERT_GT(K.norm(), 1e3);
     EXPECT_LT(RelativeError(K, -dfdx), 1e-6) << "trial " << trial;

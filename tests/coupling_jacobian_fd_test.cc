@@ -2,9 +2,8 @@
 // v + d e_k minus C at v - d e_k, over 2d, equals h J_k (the rows' J is dC/dx, x = x0 + h v; a
 // rigid body's blocks are (v, omega), integrated by Bullet's exponential map). Checked at omega = 0
 // where the map's derivative is exactly h (r x .).
-#include <gtest/gtest.h>
-
 #include <btBulletDynamicsCommon.h>
+#include <gtest/gtest.h>
 
 #include <functional>
 
@@ -94,8 +93,8 @@ TEST(CouplingJacobianFdTest, NodeAgainstDynamicRigidBoxMatchesCentralDifferences
   VecX v_box(6);
   v_box << 0.1, -0.2, 0.3, 0.0, 0.0, 0.0;
   int rows = 0;
-  const double worst = CheckRows(bodies, {VecX::Constant(3 * cube->num_nodes(), 0.05), v_box},
-                                 source, &rows);
+  const double worst =
+      CheckRows(bodies, {VecX::Constant(3 * cube->num_nodes(), 0.05), v_box}, source, &rows);
   std::printf("node vs dynamic box: %d normal rows, worst relative error %.2e\n", rows, worst);
   EXPECT_GT(rows, 0);
   EXPECT_LT(worst, 1e-6);
@@ -104,8 +103,8 @@ TEST(CouplingJacobianFdTest, NodeAgainstDynamicRigidBoxMatchesCentralDifferences
 TEST(CouplingJacobianFdTest, AttachmentRowsMatchCentralDifferences) {
   std::unique_ptr<DeformableBody> cube = MakeCube(Vec3(-0.1, -0.1, 0.0), "sleeve");
   btSphereShape shape(0.05);
-  btDefaultMotionState state(btTransform(btQuaternion(btVector3(0, 1, 2).normalized(), 0.7),
-                                         btVector3(0.01, 0.02, 0.1)));
+  btDefaultMotionState state(
+      btTransform(btQuaternion(btVector3(0, 1, 2).normalized(), 0.7), btVector3(0.01, 0.02, 0.1)));
   btVector3 inertia;
   shape.calculateLocalInertia(1.0, inertia);
   btRigidBody rigid(1.0, &state, &shape, inertia);
@@ -114,14 +113,15 @@ TEST(CouplingJacobianFdTest, AttachmentRowsMatchCentralDifferences) {
   std::vector<int> nodes = {0, 3, 5};
   std::vector<Vec3> local;
   const btTransform inverse = rigid.getWorldTransform().inverse();
-  for (int n : nodes) local.push_back(ToEigen(inverse * ToBullet(cube->node_position(n) + Vec3(0.01, 0, 0))));
+  for (int n : nodes)
+    local.push_back(ToEigen(inverse * ToBullet(cube->node_position(n) + Vec3(0.01, 0, 0))));
   NodeAttachmentSource source(*cube, &bone, nodes, local, 2);
   DeformableIslandBody flesh(*cube);
   VecX v_bone(6);
   v_bone << -0.3, 0.2, 0.1, 0.0, 0.0, 0.0;
   int rows = 0;
-  const double worst = CheckRows({&flesh, &bone}, {VecX::Constant(3 * cube->num_nodes(), -0.1), v_bone},
-                                 source, &rows);
+  const double worst = CheckRows(
+      {&flesh, &bone}, {VecX::Constant(3 * cube->num_nodes(), -0.1), v_bone}, source, &rows);
   std::printf("attachment: %d rows, worst relative error %.2e\n", rows, worst);
   EXPECT_EQ(rows, 9);
   EXPECT_LT(worst, 1e-6);

@@ -72,9 +72,10 @@ TEST(DeformableContactTest, SoftCubeDroppedOnAnotherRestsOnItWithoutPassingThrou
   }
   double top_low = HUGE_VAL;
   for (int n = 0; n < top->num_nodes(); ++n) top_low = std::min(top_low, top->node_position(n).z());
-  std::printf("cube on cube: top cube's lowest node %.4f m, worst overlap %.2e m, islands %d, "
-              "contact rows %d\n",
-              top_low, worst, holder.world.last_step_stats().islands, contact_rows);
+  std::printf(
+      "cube on cube: top cube's lowest node %.4f m, worst overlap %.2e m, islands %d, "
+      "contact rows %d\n",
+      top_low, worst, holder.world.last_step_stats().islands, contact_rows);
   EXPECT_EQ(holder.world.last_step_stats().islands, 1);  // one island: both cubes
   EXPECT_GT(top_low, 0.17);                              // resting on the bottom cube (~0.2 m)
   EXPECT_LT(worst, 5e-4);                                // never more than 0.5 mm into it
@@ -107,9 +108,10 @@ TEST(DeformableContactTest, HeadOnCollisionOfSoftCubesConservesMomentumAndSepara
   double right_v = 0.0;
   for (int n = 0; n < right->num_nodes(); ++n) right_v += right->mass()[n] * right->v()[3 * n];
   right_v /= right->mass().sum();
-  std::printf("head-on at 2 m/s: momentum drift %.2e, deepest overlap %.2e m, right cube now "
-              "%.3f m/s\n",
-              worst_drift, deepest, right_v);
+  std::printf(
+      "head-on at 2 m/s: momentum drift %.2e, deepest overlap %.2e m, right cube now "
+      "%.3f m/s\n",
+      worst_drift, deepest, right_v);
   EXPECT_LT(worst_drift, 0.01);
   EXPECT_LT(deepest, 1e-4);
   EXPECT_GT(right_v, 0.5);  // the struck cube was pushed away

@@ -28,8 +28,8 @@ struct RigidScene {
     shapes.emplace_back(shape);
     btVector3 inertia(0, 0, 0);
     if (mass > 0) shape->calculateLocalInertia(mass, inertia);
-    states.push_back(std::make_unique<btDefaultMotionState>(
-        btTransform(btQuaternion(0.1, 0.2, 0.3), position)));
+    states.push_back(
+        std::make_unique<btDefaultMotionState>(btTransform(btQuaternion(0.1, 0.2, 0.3), position)));
     bodies.push_back(std::make_unique<btRigidBody>(mass, states.back().get(), shape, inertia));
     world.addRigidBody(bodies.back().get());
     return bodies.back().get();
@@ -39,7 +39,8 @@ struct RigidScene {
     world.setGravity(btVector3(0, 0, -9.81));
     Add(new btStaticPlaneShape(btVector3(0, 0, 1), 0), 0, btVector3(0, 0, 0));
     Add(new btSphereShape(0.3), 2.0, btVector3(0.1, 0, 2));
-    for (int i = 0; i < 3; ++i) Add(new btBoxShape(btVector3(0.2, 0.2, 0.2)), 1.0, btVector3(1, 0, 0.3 + 0.5 * i));
+    for (int i = 0; i < 3; ++i)
+      Add(new btBoxShape(btVector3(0.2, 0.2, 0.2)), 1.0, btVector3(1, 0, 0.3 + 0.5 * i));
     btRigidBody* a = Add(new btCapsuleShape(0.1, 0.5), 1.0, btVector3(-1, 0, 1.5));
     hinge = std::make_unique<btHingeConstraint>(*a, btVector3(0, 0.4, 0), btVector3(1, 0, 0));
     world.addConstraint(hinge.get());
@@ -73,8 +74,8 @@ TEST(DeformableWorldTest, DeformableBodyFallsInsideSubstepsAndRefreshesItsAabb) 
   DeformableBodySettings settings;
   settings.name = "cube";
   settings.material = {1e5, 0.3, 1000};
-  DeformableBody* body = scene.world.AddTetBody(
-      MakeBoxTetMesh(Vec3(0.2, 0.2, 0.2), 2, 2, 2, Vec3(5, 5, 5)), settings);
+  DeformableBody* body =
+      scene.world.AddTetBody(MakeBoxTetMesh(Vec3(0.2, 0.2, 0.2), 2, 2, 2, Vec3(5, 5, 5)), settings);
   EXPECT_EQ(scene.world.num_deformable_bodies(), 1);
   // 1/60 s in 4 substeps of 1/240 s: free fall z = 5 - g t^2 / 2 (backward Euler: slightly less).
   scene.world.stepSimulation(1.0 / 60.0, 4, 1.0 / 240.0);
@@ -107,9 +108,11 @@ TEST(DeformableWorldTest, OneBodyFailingItsStepLeavesEveryBodyAtTheLastGoodState
   DeformableBodySettings settings;
   settings.material = {1e5, 0.3, 1000.0};
   settings.name = "good";
-  DeformableBody* good = world.AddTetBody(MakeBoxTetMesh(Vec3(0.1, 0.1, 0.1), 1, 1, 1, Vec3(0, 0, 1)), settings);
+  DeformableBody* good =
+      world.AddTetBody(MakeBoxTetMesh(Vec3(0.1, 0.1, 0.1), 1, 1, 1, Vec3(0, 0, 1)), settings);
   settings.name = "bad";
-  DeformableBody* bad = world.AddTetBody(MakeBoxTetMesh(Vec3(0.1, 0.1, 0.1), 1, 1, 1, Vec3(1, 0, 1)), settings);
+  DeformableBody* bad =
+      world.AddTetBody(MakeBoxTetMesh(Vec3(0.1, 0.1, 0.1), 1, 1, 1, Vec3(1, 0, 1)), settings);
   world.stepSimulation(1.0 / 240.0, 1, 1.0 / 240.0);
   const VecX good_x = good->x(), good_v = good->v(), bad_x = bad->x();
   bad->AddNodeForce(0, Vec3(1e300, 0, 0));  // finite, but the node would leave at 1e298 m/s

@@ -104,12 +104,13 @@ TEST(ElementStrainsTest, AxisStrainsFollowTheGivenAxes) {
 }
 
 TEST(ElementStrainsTest, HexesUnderAnAffineStretchReportItExactly) {
-  for (HexRotationMethod method : {HexRotationMethod::kCenterPolar, HexRotationMethod::kInscribedTet}) {
-    DeformableBody body(std::make_unique<HexElementModel>(
-                            std::make_shared<const HexLattice>(
-                                MakeBoxHexLattice(Vec3(0.3, 0.2, 0.4), 3, 2, 2)),
-                            MakeMaterial(), method),
-                        MakeSettings());
+  for (HexRotationMethod method :
+       {HexRotationMethod::kCenterPolar, HexRotationMethod::kInscribedTet}) {
+    DeformableBody body(
+        std::make_unique<HexElementModel>(
+            std::make_shared<const HexLattice>(MakeBoxHexLattice(Vec3(0.3, 0.2, 0.4), 3, 2, 2)),
+            MakeMaterial(), method),
+        MakeSettings());
     Deform(body, MakeRotation(), kStretch, Vec3(0.5, 0, 0));
     ExpectAffineStretch(body, CalcElementStrains(body), kStrain);
   }

@@ -26,7 +26,8 @@ void DropBlock(bool embedded_contact, double& surface_bottom, double& lattice_bo
   DeformableBody* block = holder.world.AddHexBody(lattice, settings);
   if (embedded_contact) holder.world.SetContactSurface(block, surface);
   for (int i = 0; i < 240; ++i) holder.world.stepSimulation(1.0 / 240.0, 1, 1.0 / 240.0);
-  const ContactSurface contact = MakeEmbeddedContactSurface(lattice, EmbedSurface(lattice, surface));
+  const ContactSurface contact =
+      MakeEmbeddedContactSurface(lattice, EmbedSurface(lattice, surface));
   surface_bottom = HUGE_VAL;
   for (const ContactPoint& p : contact.points)
     surface_bottom = std::min(surface_bottom, CalcContactPointPosition(p, block->x()).z());
@@ -39,12 +40,13 @@ TEST(EmbeddedContactTest, EmbeddedSurfaceRestsOnTheGroundInsteadOfTheLattice) {
   double surface_with, lattice_with, surface_without, lattice_without;
   DropBlock(true, surface_with, lattice_with);
   DropBlock(false, surface_without, lattice_without);
-  std::printf("embedded contact: surface bottom %.2e m, lattice bottom %.4f m; lattice contact: "
-              "surface bottom %.4f m, lattice bottom %.2e m\n",
-              surface_with, lattice_with, surface_without, lattice_without);
-  EXPECT_NEAR(surface_with, 0.0, 1e-4);      // the surface touches the ground
-  EXPECT_NEAR(lattice_with, 0.05, 5e-3);     // carried 5 cm up by it
-  EXPECT_NEAR(lattice_without, 0.0, 1e-4);   // the default: the lattice touches
+  std::printf(
+      "embedded contact: surface bottom %.2e m, lattice bottom %.4f m; lattice contact: "
+      "surface bottom %.4f m, lattice bottom %.2e m\n",
+      surface_with, lattice_with, surface_without, lattice_without);
+  EXPECT_NEAR(surface_with, 0.0, 1e-4);       // the surface touches the ground
+  EXPECT_NEAR(lattice_with, 0.05, 5e-3);      // carried 5 cm up by it
+  EXPECT_NEAR(lattice_without, 0.0, 1e-4);    // the default: the lattice touches
   EXPECT_NEAR(surface_without, -0.05, 5e-3);  // and the surface hangs through the ground
 }
 
@@ -76,9 +78,10 @@ TEST(EmbeddedContactTest, TetBodyRestsOnItsEmbeddedSurfaceInsteadOfItsBoundary) 
   double surface_with, mesh_with, surface_without, mesh_without;
   DropTetBlock(true, surface_with, mesh_with);
   DropTetBlock(false, surface_without, mesh_without);
-  std::printf("tet embedded contact: surface bottom %.2e m, mesh bottom %.4f m; boundary contact: "
-              "surface bottom %.4f m, mesh bottom %.2e m\n",
-              surface_with, mesh_with, surface_without, mesh_without);
+  std::printf(
+      "tet embedded contact: surface bottom %.2e m, mesh bottom %.4f m; boundary contact: "
+      "surface bottom %.4f m, mesh bottom %.2e m\n",
+      surface_with, mesh_with, surface_without, mesh_without);
   EXPECT_NEAR(surface_with, 0.0, 1e-4);      // the surface touches the ground
   EXPECT_NEAR(mesh_with, -0.05, 5e-3);       // the mesh's bottom hangs through it
   EXPECT_NEAR(mesh_without, 0.0, 1e-4);      // the default: the tet boundary touches

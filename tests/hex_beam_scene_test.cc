@@ -66,8 +66,8 @@ TEST(HexBeamSceneTest, EmbeddedCylinderSurfaceFollowsTheLatticeAndIsWritten) {
   const std::string dir = ::testing::TempDir();
   scene.WriteVtkFrame(dir, 7);
   for (const char* ext : {".vtk", ".obj"}) {
-    const std::string path = dir + "/" + scene.world().deformable_body(0).name() +
-                             "_surface_000007" + ext;
+    const std::string path =
+        dir + "/" + scene.world().deformable_body(0).name() + "_surface_000007" + ext;
     std::FILE* file = std::fopen(path.c_str(), "r");
     EXPECT_NE(file, nullptr) << path;
     if (file != nullptr) std::fclose(file);

@@ -261,8 +261,8 @@ TEST(HexElementModelTest, RefinedHexAndTetCantileversAgreeWithEachOtherAndBeamTh
   auto hex = MakeBeam(L, H, 40, 4, material, true);
   auto tet = MakeBeam(L, H, 80, 16, material, false);
   const double tip_hex = StaticTip(*hex, L), tip_tet = StaticTip(*tet, L);
-  std::printf("refined cantilevers: hex %.4e m, tet %.4e m, Timoshenko %.4e m\n", tip_hex,
-              tip_tet, timoshenko);
+  std::printf("refined cantilevers: hex %.4e m, tet %.4e m, Timoshenko %.4e m\n", tip_hex, tip_tet,
+              timoshenko);
   EXPECT_NEAR(tip_hex / tip_tet, 1.0, 0.05);
   EXPECT_NEAR(tip_hex / timoshenko, 1.0, 0.05);
   EXPECT_NEAR(tip_tet / timoshenko, 1.0, 0.05);

@@ -29,16 +29,18 @@ TEST(JointCouplingTest, PinnedBarRestingOnASoftBlockKeepsItsPivot) {
   for (int i = 0; i < 240; ++i) {
     holder.world.stepSimulation(1.0 / 240.0, 1, 1.0 / 240.0);
     const btVector3 pivot = bar->getWorldTransform() * pivot_local;
-    worst_drift = std::max(worst_drift, static_cast<double>((pivot - btVector3(-0.5, 0, 0.25)).length()));
+    worst_drift =
+        std::max(worst_drift, static_cast<double>((pivot - btVector3(-0.5, 0, 0.25)).length()));
     joint_rows = std::max(joint_rows, holder.world.last_step_stats().rows_joint);
   }
   double top = -HUGE_VAL;
   for (int i = 0; i < block->num_nodes(); ++i) top = std::max(top, block->node_position(i).z());
-  const double tip_z = static_cast<double>((bar->getWorldTransform() * btVector3(0.5, 0, -0.05)).z());
-  std::printf("pinned bar on a soft block: pivot drift %.2e m, joint rows %d, coupled %d, bar tip "
-              "bottom %.4f m, block top %.4f m\n",
-              worst_drift, joint_rows, holder.world.last_step_stats().rigid_bodies_coupled, tip_z,
-              top);
+  const double tip_z =
+      static_cast<double>((bar->getWorldTransform() * btVector3(0.5, 0, -0.05)).z());
+  std::printf(
+      "pinned bar on a soft block: pivot drift %.2e m, joint rows %d, coupled %d, bar tip "
+      "bottom %.4f m, block top %.4f m\n",
+      worst_drift, joint_rows, holder.world.last_step_stats().rigid_bodies_coupled, tip_z, top);
   EXPECT_EQ(holder.world.last_step_stats().rigid_bodies_coupled, 1);
   EXPECT_EQ(joint_rows, 3);  // point-to-point: three rows, solved in the island
   EXPECT_LT(worst_drift, 2e-3);

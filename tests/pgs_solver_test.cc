@@ -2,8 +2,6 @@
 // active-set enumeration, known-solution random LCPs, friction cones, and no heap allocation.
 #include "constraints/pgs_solver.h"
 
-#include "tests/allocation_counter.h"
-
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -12,6 +10,8 @@
 #include <cstdlib>
 #include <new>
 #include <random>
+
+#include "tests/allocation_counter.h"
 
 namespace taut {
 namespace {

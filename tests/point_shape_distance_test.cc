@@ -393,9 +393,12 @@ TEST(PointShapeDistanceTest, HullInsidePointsUseFacePlanesWhenAvailable) {
     const Vec3 world = ToEigen(t * ToBullet(local));
     const PointContact c = CalcPointShapeDistance(world, hull, t, 1.0);
     ASSERT_TRUE(c.valid);
-    EXPECT_NEAR(c.gap, (l1 - 0.5) / std::sqrt(3.0) - margin, 1e-12) << "point " << local.transpose();
-    const Vec3 expected_normal = ToEigen(t.getBasis() * ToBullet(Vec3(local.array().sign()) / std::sqrt(3.0)));
-    if ((local.cwiseAbs().array() > 1e-9).all()) EXPECT_GT(c.normal.dot(expected_normal), 1.0 - 1e-9);
+    EXPECT_NEAR(c.gap, (l1 - 0.5) / std::sqrt(3.0) - margin, 1e-12)
+        << "point " << local.transpose();
+    const Vec3 expected_normal =
+        ToEigen(t.getBasis() * ToBullet(Vec3(local.array().sign()) / std::sqrt(3.0)));
+    if ((local.cwiseAbs().array() > 1e-9).all())
+      EXPECT_GT(c.normal.dot(expected_normal), 1.0 - 1e-9);
   }
   EXPECT_EQ(tested, 500);
 }

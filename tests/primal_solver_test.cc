@@ -5,10 +5,9 @@
 // certified in every step.
 #include "constraints/primal_solver.h"
 
-#include <gtest/gtest.h>
-
 #include <BulletCollision/CollisionShapes/btBoxShape.h>
 #include <BulletCollision/CollisionShapes/btStaticPlaneShape.h>
+#include <gtest/gtest.h>
 
 #include "bullet_bridge/eigen_bullet.h"
 #include "constraints/island_solver.h"
@@ -48,7 +47,8 @@ struct SaggingBar {
 TEST(PrimalSolverTest, SameFirstConstrainedStepAsTheDualPath) {
   // One step from the same state: both paths solve the same convex-in-v problem to tolerance, so
   // the velocities agree to the tolerance's order.
-  SaggingBar dual(IslandSolverKind::kDual, 0.99, 1.01), primal(IslandSolverKind::kPrimal, 0.99, 1.01);
+  SaggingBar dual(IslandSolverKind::kDual, 0.99, 1.01),
+      primal(IslandSolverKind::kPrimal, 0.99, 1.01);
   // Give both a stretching velocity that violates the limits in one step.
   VecX v = VecX::Zero(3 * dual.body->num_nodes());
   for (int i = 0; i < dual.body->num_nodes(); ++i)
@@ -115,7 +115,8 @@ TEST(PrimalSolverTest, SwingingAnisotropicBeamIsCertifiedEveryStep) {
 TEST(PrimalSolverTest, KeptFactorsGiveTheStepsOfFreshFactors) {
   // Factor reuse only changes how the Newton step is solved (CG on the exact H, preconditioned by
   // an earlier factor): the certified answer is the same, with fewer factorizations.
-  SaggingBar fresh(IslandSolverKind::kPrimal, 0.99, 1.01), kept(IslandSolverKind::kPrimal, 0.99, 1.01);
+  SaggingBar fresh(IslandSolverKind::kPrimal, 0.99, 1.01),
+      kept(IslandSolverKind::kPrimal, 0.99, 1.01);
   fresh.holder.world.mutable_solver_settings().primal.reuse_factorization = false;
   kept.holder.world.mutable_solver_settings().primal.min_refactor_cost = 0.0;  // every body keeps
   int fresh_factorizations = 0, kept_factorizations = 0, fresh_newton = 0, kept_pcg = 0;
@@ -219,9 +220,10 @@ TEST(PrimalSolverTest, RigidBoxOnASoftBlockComesToRest) {
   // settles; rest is rest (< 0.1 mm over the last second), every step converged.
   const BoxOnBlock primal = RestBoxOnBlock(IslandSolverKind::kPrimal);
   const BoxOnBlock dual = RestBoxOnBlock(IslandSolverKind::kDual);
-  std::printf("box on soft block, z at 1 s -> 2 s: primal %.6f -> %.6f m (%d unconverged), dual "
-              "%.6f -> %.6f m (%d unconverged)\n",
-              primal.z_1s, primal.z_2s, primal.unconverged, dual.z_1s, dual.z_2s, dual.unconverged);
+  std::printf(
+      "box on soft block, z at 1 s -> 2 s: primal %.6f -> %.6f m (%d unconverged), dual "
+      "%.6f -> %.6f m (%d unconverged)\n",
+      primal.z_1s, primal.z_2s, primal.unconverged, dual.z_1s, dual.z_2s, dual.unconverged);
   EXPECT_EQ(primal.coupled, 1);
   EXPECT_EQ(primal.unconverged, 0);
   EXPECT_LT(std::abs(primal.z_2s - primal.z_1s), 1e-4);

@@ -1,7 +1,6 @@
 // Pictures (demos/render): a rendered frame of a small scene is a non-empty PNG in which the body
 // covers the part of the image it projects to, and nothing else looks like a body.
 #include <gtest/gtest.h>
-
 #include <stb_image.h>
 
 #include <cmath>
@@ -59,8 +58,8 @@ TEST(RenderTest, FrameOfOneSphereCoversItsProjection) {
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
       const unsigned char* p = pixels + 3 * (y * width + x);
-      const bool in = x + 0.5 >= lo_x - 1 && x + 0.5 <= hi_x + 1 && y + 0.5 >= lo_y - 1 &&
-                      y + 0.5 <= hi_y + 1;
+      const bool in =
+          x + 0.5 >= lo_x - 1 && x + 0.5 <= hi_x + 1 && y + 0.5 >= lo_y - 1 && y + 0.5 <= hi_y + 1;
       inside += in;
       if (IsBodyPixel(p)) (in ? inside_body : outside_body) += 1;
       if (!in && !IsBodyPixel(p) && p[0] < 250) ++ground;  // checkered ground or shadow
@@ -92,7 +91,8 @@ TEST(RenderTest, RecorderWritesKeyFramesFigureAndGif) {
   const PictureReport report = recorder.Finish(scene.GetCameraDirection());
   EXPECT_EQ(report.key_frames, 2);  // start and rest (no impact within 8 steps)
   EXPECT_EQ(report.gif_frames, 5);  // steps 0, 2, 4, 6, 8
-  for (const std::string& file : report.files) EXPECT_GT(std::filesystem::file_size(file), 100u) << file;
+  for (const std::string& file : report.files)
+    EXPECT_GT(std::filesystem::file_size(file), 100u) << file;
   EXPECT_TRUE(std::filesystem::exists(dir + "/key_00_start.png"));
   EXPECT_TRUE(std::filesystem::exists(dir + "/figure.png"));
   std::filesystem::remove_all(dir);

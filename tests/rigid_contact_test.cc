@@ -57,7 +57,7 @@ TEST(RigidContactTest, DroppedCubeComesToRestOnTheGroundWithoutSinkingIn) {
   }
   std::printf("dropped cube: deepest node %.2e m, rest height %.4f m, contact rows %d\n", deepest,
               scene.MinZ(), scene.holder.world.last_step_stats().rows_contact);
-  EXPECT_GT(deepest, -2e-3);  // penetration below 2 mm even at the 1.4 m/s impact
+  EXPECT_GT(deepest, -2e-3);      // penetration below 2 mm even at the 1.4 m/s impact
   EXPECT_LT(scene.MinZ(), 0.01);  // it did land
   EXPECT_GT(scene.holder.world.last_step_stats().rows_contact, 0);
   EXPECT_LT(scene.cube->v().norm() / std::sqrt(scene.cube->num_nodes()), 0.05);  // at rest
@@ -74,9 +74,10 @@ TEST(RigidContactTest, FrictionSticksBelowTheConeAndSlidesAboveIt) {
   const double stick = sticky.MeanX() - x0, slide = slippery.MeanX() - x0;
   // Sliding block: a = g (sin - mu cos) = 4.06 m/s^2 -> 0.51 m in 0.5 s.
   const double expected = 0.5 * 9.81 * (std::sin(theta) - 0.1 * std::cos(theta)) * 0.25;
-  std::printf("incline 30 deg, 0.5 s: mu = 1 moves %.4f m, mu = 0.1 moves %.4f m (rigid block "
-              "%.4f m)\n",
-              stick, slide, expected);
+  std::printf(
+      "incline 30 deg, 0.5 s: mu = 1 moves %.4f m, mu = 0.1 moves %.4f m (rigid block "
+      "%.4f m)\n",
+      stick, slide, expected);
   EXPECT_LT(stick, 0.02);
   EXPECT_NEAR(slide, expected, 0.25 * expected);
   EXPECT_GT(slippery.MinZ(), -2e-3);
@@ -101,9 +102,8 @@ TEST(RigidAttachmentTest, KinematicBoneDrivesPinnedSoftFlesh) {
   DeformableBodySettings settings;
   settings.material = {2e4, 0.3, 500.0};
   settings.mass_damping = 2.0;
-  DeformableBody* flesh =
-      holder.world.AddTetBody(MakeBoxTetMesh(Vec3(0.2, 0.2, 0.2), 2, 2, 2, Vec3(-0.1, -0.1, 0)),
-                              settings);
+  DeformableBody* flesh = holder.world.AddTetBody(
+      MakeBoxTetMesh(Vec3(0.2, 0.2, 0.2), 2, 2, 2, Vec3(-0.1, -0.1, 0)), settings);
   std::vector<int> top;
   for (int i = 0; i < flesh->num_nodes(); ++i)
     if (flesh->node_position(i).z() > 0.2 - 1e-9) top.push_back(i);
@@ -123,7 +123,8 @@ TEST(RigidAttachmentTest, KinematicBoneDrivesPinnedSoftFlesh) {
     EXPECT_LT((flesh->node_position(i) - expected).norm(), 1e-9) << "node " << i;
   }
   double lowest = 1e9;
-  for (int i = 0; i < flesh->num_nodes(); ++i) lowest = std::min(lowest, flesh->node_position(i).z());
+  for (int i = 0; i < flesh->num_nodes(); ++i)
+    lowest = std::min(lowest, flesh->node_position(i).z());
   EXPECT_GT(lowest, 0.3);  // the whole body came up with the bone
   holder.world.removeRigidBody(&bone);
 }

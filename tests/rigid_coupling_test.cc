@@ -83,14 +83,15 @@ TEST(RigidCouplingTest, HeavyBoxRestsOnASoftLimitedBlockWithoutSinking) {
   }
   const double final_bottom = static_cast<double>(box->getWorldTransform().getOrigin().z()) - 0.05;
   const StepStats& stats = holder.world.last_step_stats();
-  std::printf("box %.0f kg on %.1f kg block, %d steps: penetration %.2e m, box bottom %.4f m (lowest in "
-              "2nd half %.4f), block min z %.2e, islands %d, coupled %d, strain rows %d, violation "
-              "%.2e\n",
-              100.0 * block_mass, block_mass, steps, deepest, final_bottom, lowest_box, MinZ(*block),
-              stats.islands, stats.rigid_bodies_coupled, stats.rows_strain, stats.violation_after);
+  std::printf(
+      "box %.0f kg on %.1f kg block, %d steps: penetration %.2e m, box bottom %.4f m (lowest in "
+      "2nd half %.4f), block min z %.2e, islands %d, coupled %d, strain rows %d, violation "
+      "%.2e\n",
+      100.0 * block_mass, block_mass, steps, deepest, final_bottom, lowest_box, MinZ(*block),
+      stats.islands, stats.rigid_bodies_coupled, stats.rows_strain, stats.violation_after);
   EXPECT_EQ(stats.rigid_bodies_coupled, 1);
-  EXPECT_GT(final_bottom, 0.2 * 0.9 - 1e-3);  // the 10 % compression limit holds the box up
-  EXPECT_LT(final_bottom, 0.2);                // and the block does carry it (compressed)
+  EXPECT_GT(final_bottom, 0.2 * 0.9 - 1e-3);    // the 10 % compression limit holds the box up
+  EXPECT_LT(final_bottom, 0.2);                 // and the block does carry it (compressed)
   EXPECT_LT(deepest, 1e-3);                     // penetration below 1 mm
   EXPECT_GT(MinZ(*block), -2e-3);               // the block stays on the ground
   EXPECT_NEAR(final_bottom, lowest_box, 2e-3);  // not sinking: the second half is at rest
@@ -101,8 +102,8 @@ TEST(RigidCouplingTest, BallHittingAFreeSoftBodyConservesLinearMomentum) {
   holder.world.setGravity(btVector3(0, 0, 0));
   DeformableBody* block = holder.world.AddTetBody(
       MakeBoxTetMesh(Vec3(0.2, 0.2, 0.2), 2, 2, 2, Vec3(-0.1, -0.1, -0.1)), SoftSettings(1e5));
-  btRigidBody* ball = holder.AddRigidBody(std::make_unique<btSphereShape>(0.05), 2.0,
-                                          btVector3(-0.3, 0.02, 0.01));
+  btRigidBody* ball =
+      holder.AddRigidBody(std::make_unique<btSphereShape>(0.05), 2.0, btVector3(-0.3, 0.02, 0.01));
   ball->setLinearVelocity(btVector3(3.0, 0, 0));
   const Vec3 p0 = CalcMomentum(holder.world);
   double worst = 0.0;
@@ -113,9 +114,10 @@ TEST(RigidCouplingTest, BallHittingAFreeSoftBodyConservesLinearMomentum) {
     if (holder.world.last_step_stats().rows_contact > 0) contact_steps++;
   }
   const double ball_v = static_cast<double>(ball->getLinearVelocity().x());
-  std::printf("ball 2 kg at 3 m/s into a %.1f kg block: worst momentum drift %.2e, contact steps "
-              "%d, ball vx after %.3f m/s\n",
-              block->mass().sum(), worst, contact_steps, ball_v);
+  std::printf(
+      "ball 2 kg at 3 m/s into a %.1f kg block: worst momentum drift %.2e, contact steps "
+      "%d, ball vx after %.3f m/s\n",
+      block->mass().sum(), worst, contact_steps, ball_v);
   EXPECT_GT(contact_steps, 0);
   EXPECT_LT(ball_v, 2.0);  // the block pushed back
   EXPECT_LT(worst, 0.01);
@@ -143,14 +145,16 @@ TEST(RigidCouplingTest, DynamicBoneAndAttachedFleshMoveTogetherBothWays) {
     const btTransform t = rod->getWorldTransform();
     for (int node : bone_nodes) {
       const Vec3 rest = sleeve->model().rest_positions().segment<3>(3 * node);
-      worst_gap = std::max(worst_gap, (sleeve->node_position(node) - ToEigen(t * ToBullet(rest))).norm());
+      worst_gap =
+          std::max(worst_gap, (sleeve->node_position(node) - ToEigen(t * ToBullet(rest))).norm());
     }
   }
   const double total_mass = 1.0 + sleeve->mass().sum();
   const double rod_vz = static_cast<double>(rod->getLinearVelocity().z());
-  std::printf("rod + sleeve: rod vz %.4f m/s (momentum/total mass %.4f), worst anchor gap %.2e m, "
-              "joint rows %d\n",
-              rod_vz, 1.0 / total_mass, worst_gap, holder.world.last_step_stats().rows_joint);
+  std::printf(
+      "rod + sleeve: rod vz %.4f m/s (momentum/total mass %.4f), worst anchor gap %.2e m, "
+      "joint rows %d\n",
+      rod_vz, 1.0 / total_mass, worst_gap, holder.world.last_step_stats().rows_joint);
   EXPECT_EQ(holder.world.last_step_stats().rows_joint, 3 * static_cast<int>(bone_nodes.size()));
   EXPECT_LT(worst_gap, 1e-3);
   EXPECT_LT((CalcMomentum(holder.world) - p0).norm(), 0.01 * p0.norm());
@@ -159,7 +163,8 @@ TEST(RigidCouplingTest, DynamicBoneAndAttachedFleshMoveTogetherBothWays) {
   // matches the rod's.
   const double shared = 1.0 / total_mass;
   double sleeve_vz = 0.0;
-  for (int i = 0; i < sleeve->num_nodes(); ++i) sleeve_vz += sleeve->mass()[i] * sleeve->v()[3 * i + 2];
+  for (int i = 0; i < sleeve->num_nodes(); ++i)
+    sleeve_vz += sleeve->mass()[i] * sleeve->v()[3 * i + 2];
   sleeve_vz /= sleeve->mass().sum();
   EXPECT_NEAR(rod_vz, shared, 0.5 * shared);
   EXPECT_NEAR(sleeve_vz, shared, 0.5 * shared);
@@ -180,12 +185,13 @@ TEST(RigidCouplingTest, RigidStackOnASoftBodyHoldsThroughTheIslandsRigidContacts
     rigid_rows = std::max(rigid_rows, holder.world.last_step_stats().rows_rigid_contact);
   }
   const StepStats& stats = holder.world.last_step_stats();
-  std::printf("stack of 3 on a pad: box z %.4f %.4f %.4f, pad top %.4f, coupled %d, rigid rows "
-              "%d\n",
-              static_cast<double>(boxes[0]->getWorldTransform().getOrigin().z()),
-              static_cast<double>(boxes[1]->getWorldTransform().getOrigin().z()),
-              static_cast<double>(boxes[2]->getWorldTransform().getOrigin().z()), MaxZ(*pad),
-              stats.rigid_bodies_coupled, rigid_rows);
+  std::printf(
+      "stack of 3 on a pad: box z %.4f %.4f %.4f, pad top %.4f, coupled %d, rigid rows "
+      "%d\n",
+      static_cast<double>(boxes[0]->getWorldTransform().getOrigin().z()),
+      static_cast<double>(boxes[1]->getWorldTransform().getOrigin().z()),
+      static_cast<double>(boxes[2]->getWorldTransform().getOrigin().z()), MaxZ(*pad),
+      stats.rigid_bodies_coupled, rigid_rows);
   EXPECT_EQ(stats.rigid_bodies_coupled, 3);
   EXPECT_GT(rigid_rows, 0);
   for (int k = 0; k < 3; ++k) {
@@ -229,9 +235,10 @@ double CalcBounceOnSlab(double restitution) {
 
 TEST(RigidCouplingTest, RestitutionOfRigidContactsInsideTheIslandIsHonoured) {
   const double elastic = CalcBounceOnSlab(0.9), inelastic = CalcBounceOnSlab(0.0);
-  std::printf("ball on a slab on a soft pad, dropped 0.5 m: bounce %.4f m (e = 0.9, ideal %.4f), "
-              "%.4f m (e = 0)\n",
-              elastic, 0.81 * 0.5, inelastic);
+  std::printf(
+      "ball on a slab on a soft pad, dropped 0.5 m: bounce %.4f m (e = 0.9, ideal %.4f), "
+      "%.4f m (e = 0)\n",
+      elastic, 0.81 * 0.5, inelastic);
   EXPECT_NEAR(elastic, 0.81 * 0.5, 0.05 * 0.81 * 0.5);  // e^2 h: the 50 kg slab barely moves
   EXPECT_LT(inelastic, 0.01);
 }

@@ -1,9 +1,8 @@
 // Warm-start row keys (constraints/row_key.h, constraints/row_key_layouts.h): every field is
 // checked against its width, keys round-trip, keys of different sources never collide, and the
 // objects, ids and rows that the hand-packed layouts used to alias get different keys.
-#include <gtest/gtest.h>
-
 #include <btBulletDynamicsCommon.h>
+#include <gtest/gtest.h>
 
 #include <iterator>
 #include <map>
@@ -59,8 +58,7 @@ std::unique_ptr<DeformableBody> MakeCube(const Vec3& corner) {
   DeformableBodySettings settings;
   settings.name = "cube";
   settings.material = {1e5, 0.3, 1000.0};
-  auto mesh =
-      std::make_shared<const TetMesh>(MakeBoxTetMesh(Vec3(0.2, 0.2, 0.2), 1, 1, 1, corner));
+  auto mesh = std::make_shared<const TetMesh>(MakeBoxTetMesh(Vec3(0.2, 0.2, 0.2), 1, 1, 1, corner));
   auto body = std::make_unique<DeformableBody>(
       std::make_unique<TetElementModel>(mesh, settings.material), settings);
   body->BeginStep(kH, Vec3::Zero());
@@ -231,7 +229,7 @@ TEST(RowKeyTest, RigidObjectsWhoseWorldIndicesDifferBy4096Or65536GetDifferentKey
   source.set_objects({&near, &far});
   DeformableIslandBody body(*cube);
   const std::pair<int, int> indices[] = {{3, 3 + 4096}, {3, 3 + 65536}, {0, 1 << 20},
-                                         {-1, -1},      {-1, 0},         {1, -1}};
+                                         {-1, -1},      {-1, 0},        {1, -1}};
   for (const auto& [near_index, far_index] : indices) {
     near.setWorldArrayIndex(near_index);
     far.setWorldArrayIndex(far_index);

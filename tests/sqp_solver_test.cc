@@ -57,8 +57,8 @@ TEST(SqpSolverTest, IsotropicLimitHoldsWhereTheUnlimitedBodyStretchesFar) {
 
 TEST(SqpSolverTest, EnergyLimitThroughTheWorldCapsEveryElement) {
   PulledCube free_cube(2e3), limited(2e3);
-  EnergyLimitConstraint* limit = limited.holder.world.SetEnergyLimits(
-      limited.body, EnergyLimitSettings::EnergyDensity(20.0));
+  EnergyLimitConstraint* limit =
+      limited.holder.world.SetEnergyLimits(limited.body, EnergyLimitSettings::EnergyDensity(20.0));
   free_cube.Run(120, 2.0);
   double worst = 0.0;
   for (int step = 0; step < 120; ++step) {
@@ -89,9 +89,10 @@ TEST(SqpSolverTest, TightOnePercentLimitOnOneKilopascalBodyHolds2000Steps) {
     worst = std::max(worst, limit->CalcMaxViolation(body->x()));
     unconverged += holder.world.last_step_stats().converged ? 0 : 1;
   }
-  std::printf("1 %% limit, 2000 steps: worst violation %.2e (fraction of the limit), %d "
-              "unconverged steps\n",
-              worst, unconverged);
+  std::printf(
+      "1 %% limit, 2000 steps: worst violation %.2e (fraction of the limit), %d "
+      "unconverged steps\n",
+      worst, unconverged);
   EXPECT_LE(worst, 2e-3);
   EXPECT_EQ(unconverged, 0);
 }

@@ -14,24 +14,40 @@ namespace {
 // Stats whose every field is a different value derived from `seed`.
 StepStats MakeStats(int seed, bool converged) {
   StepStats s;
-  double* times[] = {&s.ms_unconstrained,       &s.ms_rows,
-                     &s.ms_solve,               &s.ms_integrate,
-                     &s.ms_rigid,               &s.ms_total,
-                     &s.ms_stage_begin_steps,   &s.ms_stage_partners,
-                     &s.ms_stage_islands,       &s.ms_stage_couple_rigid,
-                     &s.ms_stage_row_sources,   &s.ms_stage_bullet_solver,
-                     &s.ms_stage_solve_islands, &s.ms_stage_end_steps};
+  double* times[] = {&s.ms_unconstrained,
+                     &s.ms_rows,
+                     &s.ms_solve,
+                     &s.ms_integrate,
+                     &s.ms_rigid,
+                     &s.ms_total,
+                     &s.ms_stage_begin_steps,
+                     &s.ms_stage_partners,
+                     &s.ms_stage_islands,
+                     &s.ms_stage_couple_rigid,
+                     &s.ms_stage_row_sources,
+                     &s.ms_stage_bullet_solver,
+                     &s.ms_stage_solve_islands,
+                     &s.ms_stage_end_steps};
   for (int k = 0; k < 14; ++k) *times[k] = 0.25 * (seed + 2 * k + 1);
-  int* counts[] = {&s.rows_strain,        &s.rows_energy,         &s.rows_contact,
-                   &s.rows_rigid_contact, &s.rows_joint,          &s.pgs_sweeps,
-                   &s.active_set_solves,  &s.sqp_iterations,      &s.restoration_iterations,
-                   &s.islands_dual,       &s.islands_primal,      &s.newton_iterations,
-                   &s.pcg_iterations,     &s.newton_factorizations, &s.islands,
+  int* counts[] = {&s.rows_strain,
+                   &s.rows_energy,
+                   &s.rows_contact,
+                   &s.rows_rigid_contact,
+                   &s.rows_joint,
+                   &s.pgs_sweeps,
+                   &s.active_set_solves,
+                   &s.sqp_iterations,
+                   &s.restoration_iterations,
+                   &s.islands_dual,
+                   &s.islands_primal,
+                   &s.newton_iterations,
+                   &s.pcg_iterations,
+                   &s.newton_factorizations,
+                   &s.islands,
                    &s.rigid_bodies_coupled};
   for (int k = 0; k < 16; ++k) *counts[k] = seed * 100 + k;
-  double* worst[] = {&s.violation_before, &s.violation_after, &s.stationarity,
-                     &s.lcp_residual,     &s.kkt_primal,      &s.kkt_complementarity,
-                     &s.kkt_dual};
+  double* worst[] = {&s.violation_before, &s.violation_after,     &s.stationarity, &s.lcp_residual,
+                     &s.kkt_primal,       &s.kkt_complementarity, &s.kkt_dual};
   for (int k = 0; k < 7; ++k) *worst[k] = (k % 2 == seed % 2) ? 1e-3 * (k + 1) : 1e-6 * (k + 1);
   for (int i = 0; i < 5; ++i) {
     s.kkt_primal_by_type[i] = (i % 2 == seed % 2) ? 2e-3 : 2e-6;

@@ -13,8 +13,8 @@ TEST(BoxTetMesherTest, CountsVolumeAndConformingBoundary) {
   EXPECT_EQ(mesh.tets.size(), 6u * 5u * 2u * 3u);
   double volume = 0.0;
   for (const auto& t : mesh.tets) {
-    const double v = CalcTetSignedVolume(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]],
-                                         mesh.nodes[t[3]]);
+    const double v =
+        CalcTetSignedVolume(mesh.nodes[t[0]], mesh.nodes[t[1]], mesh.nodes[t[2]], mesh.nodes[t[3]]);
     EXPECT_GT(v, 0.0);
     volume += v;
   }
@@ -48,8 +48,8 @@ TEST(TetMeshValidationTest, RejectsBadElementsNamingThem) {
   TetMesh flat = mesh;
   flat.nodes.push_back(Vec3(0.5, 0.5, 0.0));
   flat.nodes.push_back(Vec3(0.7, 0.2, 0.0));
-  flat.tets.push_back({0, 1, static_cast<int>(flat.nodes.size()) - 2,
-                       static_cast<int>(flat.nodes.size()) - 1});
+  flat.tets.push_back(
+      {0, 1, static_cast<int>(flat.nodes.size()) - 2, static_cast<int>(flat.nodes.size()) - 1});
   EXPECT_THROW(ValidateTetMesh(flat), InputError);
   TetMesh out_of_range = mesh;
   out_of_range.tets[0][2] = 99;

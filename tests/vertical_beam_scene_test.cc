@@ -9,9 +9,9 @@ namespace {
 
 // Paper A Fig. 4 claims on a coarse column (1 x 1 x 4 cubes), 100 steps of 1/240 s.
 TEST(VerticalBeamSceneTest, HyperbolicAndEllipsoidHoldTheTransverseLimitOrthogonalFreezes) {
-  VerticalBeamScene scene({StrainProjection::kHyperbolic, StrainProjection::kEllipsoid,
-                           StrainProjection::kOrthogonal},
-                          1, 4);
+  VerticalBeamScene scene(
+      {StrainProjection::kHyperbolic, StrainProjection::kEllipsoid, StrainProjection::kOrthogonal},
+      1, 4);
   for (int step = 0; step < 100; ++step) scene.Step(1.0 / 240.0);
   for (int c = 0; c < 2; ++c) {
     // The column collapses (no freezing) ...
@@ -71,9 +71,10 @@ TEST(VerticalBeamSceneTest, ExactJacobianNeedsFewerSqpIterationsThanFrozenFrame)
   double exact_violation = 0.0, frozen_violation = 0.0;
   const double exact = MeanSqpIterations(false, &exact_violation);
   const double frozen = MeanSqpIterations(true, &frozen_violation);
-  std::printf("SQP iterations per constrained step: exact %.2f (worst violation %.2e), frozen "
-              "frame %.2f (%.2e)\n",
-              exact, exact_violation, frozen, frozen_violation);
+  std::printf(
+      "SQP iterations per constrained step: exact %.2f (worst violation %.2e), frozen "
+      "frame %.2f (%.2e)\n",
+      exact, exact_violation, frozen, frozen_violation);
   EXPECT_LT(exact, frozen);
   EXPECT_LE(exact_violation, 2e-3);
 }

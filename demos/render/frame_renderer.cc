@@ -29,8 +29,10 @@ Vec3 CalcFaceNormal(const Vec3& a, const Vec3& b, const Vec3& c) {
 }
 
 void DrawGround(const Ground& ground, const Camera& camera, Rasterizer& raster) {
-  const int nx = std::clamp(static_cast<int>(std::ceil((ground.hi.x() - ground.lo.x()) / ground.tile)), 1, 400);
-  const int ny = std::clamp(static_cast<int>(std::ceil((ground.hi.y() - ground.lo.y()) / ground.tile)), 1, 400);
+  const int nx = std::clamp(
+      static_cast<int>(std::ceil((ground.hi.x() - ground.lo.x()) / ground.tile)), 1, 400);
+  const int ny = std::clamp(
+      static_cast<int>(std::ceil((ground.hi.y() - ground.lo.y()) / ground.tile)), 1, 400);
   for (int i = 0; i < nx; ++i) {
     for (int j = 0; j < ny; ++j) {
       const double x0 = ground.lo.x() + i * ground.tile, y0 = ground.lo.y() + j * ground.tile;
@@ -38,8 +40,10 @@ void DrawGround(const Ground& ground, const Camera& camera, Rasterizer& raster) 
       const double y1 = std::min(y0 + ground.tile, ground.hi.y());
       const Vec3 c = ((i + j) % 2 == 0) ? kGroundLight : kGroundDark;
       const Vec3 colours[3] = {c, c, c};
-      const Vec3 a = camera.Project(Vec3(x0, y0, ground.z)), b = camera.Project(Vec3(x1, y0, ground.z));
-      const Vec3 d = camera.Project(Vec3(x1, y1, ground.z)), e = camera.Project(Vec3(x0, y1, ground.z));
+      const Vec3 a = camera.Project(Vec3(x0, y0, ground.z)),
+                 b = camera.Project(Vec3(x1, y0, ground.z));
+      const Vec3 d = camera.Project(Vec3(x1, y1, ground.z)),
+                 e = camera.Project(Vec3(x0, y1, ground.z));
       const Vec3 t0[3] = {a, b, d}, t1[3] = {a, d, e};
       raster.DrawTriangle(t0, colours);
       raster.DrawTriangle(t1, colours);
@@ -108,8 +112,9 @@ struct Box {
 // Labels next to their bodies, placed greedily: above the body, else to its right or left at
 // mid-height, else higher above or below, whichever first covers no body pixel (tags >= 0 in the
 // rasterizer) and no placed label.
-void DrawLabels(const std::vector<RenderMesh>& meshes, const Camera& camera, const FrameStyle& style,
-                const std::string& caption, const Rasterizer& raster, Image& image) {
+void DrawLabels(const std::vector<RenderMesh>& meshes, const Camera& camera,
+                const FrameStyle& style, const std::string& caption, const Rasterizer& raster,
+                Image& image) {
   const int scale = std::max(1, style.text_scale - (style.width < 480 ? 1 : 0));
   std::vector<Box> bodies;
   std::vector<int> top_x;  // image x of each body's highest point: labels above it
@@ -138,8 +143,8 @@ void DrawLabels(const std::vector<RenderMesh>& meshes, const Camera& camera, con
     const Box& b = bodies[m];
     const int w = CalcTextWidth(label, scale), h = CalcTextHeight(label, scale), gap = 3 * scale;
     const int mid_x = top_x[m] - w / 2, mid_y = (b.y0 + b.y1) / 2 - h / 2;
-    const int candidates[][2] = {{mid_x, b.y0 - h - gap},       {b.x1 + gap, mid_y},
-                                 {b.x0 - w - gap, mid_y},       {mid_x, b.y0 - 2 * h - 2 * gap},
+    const int candidates[][2] = {{mid_x, b.y0 - h - gap},         {b.x1 + gap, mid_y},
+                                 {b.x0 - w - gap, mid_y},         {mid_x, b.y0 - 2 * h - 2 * gap},
                                  {mid_x, b.y0 - 3 * h - 3 * gap}, {mid_x, b.y1 + gap}};
     Box chosen{};
     bool have_fallback = false;

@@ -21,8 +21,8 @@ struct Ground {
 // Look of a frame.
 struct FrameStyle {
   int width = 640, height = 360;
-  int text_scale = 2;   // pixel size of a font unit
-  bool labels = true;   // a label above every body that has one
+  int text_scale = 2;  // pixel size of a font unit
+  bool labels = true;  // a label above every body that has one
   Vec3 background = Vec3(1.0, 1.0, 1.0);
 };
 

@@ -49,8 +49,10 @@ void Rasterizer::DrawTriangle(const Vec3 p[3], const Vec3 colour[3]) {
     for (int x = x0; x <= x1; ++x) {
       const double px = x + 0.5;
       // Barycentric weights of the pixel centre (edge functions over the signed area).
-      const double w0 = ((p[1].x() - px) * (p[2].y() - py) - (p[2].x() - px) * (p[1].y() - py)) * inv;
-      const double w1 = ((p[2].x() - px) * (p[0].y() - py) - (p[0].x() - px) * (p[2].y() - py)) * inv;
+      const double w0 =
+          ((p[1].x() - px) * (p[2].y() - py) - (p[2].x() - px) * (p[1].y() - py)) * inv;
+      const double w1 =
+          ((p[2].x() - px) * (p[0].y() - py) - (p[0].x() - px) * (p[2].y() - py)) * inv;
       const double w2 = 1.0 - w0 - w1;
       if (w0 < 0.0 || w1 < 0.0 || w2 < 0.0) continue;
       const float z = static_cast<float>(w0 * p[0].z() + w1 * p[1].z() + w2 * p[2].z());

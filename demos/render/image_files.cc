@@ -1,22 +1,23 @@
 #include "demos/render/image_files.h"
 
+#include <stb_image_write.h>
+
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
-#include <stb_image_write.h>
-
 namespace taut::render {
 
 void WritePng(const Image& image, const std::string& path) {
   TAUT_DEMAND(image.width > 0 && image.height > 0, "PNG ", path, ": empty image");
-  const int ok = stbi_write_png(path.c_str(), image.width, image.height, 3, image.rgb.data(),
-                                image.width * 3);
+  const int ok =
+      stbi_write_png(path.c_str(), image.width, image.height, 3, image.rgb.data(), image.width * 3);
   TAUT_DEMAND(ok != 0, "cannot write PNG ", path);
 }
 
-GifWriter::GifWriter(std::string path, int delay_cs) : path_(std::move(path)), delay_cs_(delay_cs) {}
+GifWriter::GifWriter(std::string path, int delay_cs)
+    : path_(std::move(path)), delay_cs_(delay_cs) {}
 
 GifWriter::~GifWriter() { RemoveFrames(); }
 

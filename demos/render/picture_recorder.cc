@@ -76,7 +76,8 @@ PictureRecorder::PictureRecorder(std::string out_dir, std::string scene_name, in
       num_steps_(num_steps),
       dt_(dt),
       settings_(settings),
-      gif_every_(std::max(1, (num_steps + settings.gif_frames - 1) / std::max(1, settings.gif_frames))) {}
+      gif_every_(
+          std::max(1, (num_steps + settings.gif_frames - 1) / std::max(1, settings.gif_frames))) {}
 
 void PictureRecorder::Record(Scene& scene, int step) {
   const std::vector<Scene::KeyFrame> keys = scene.CollectKeyFrames(step, num_steps_);
@@ -97,7 +98,8 @@ void PictureRecorder::Record(Scene& scene, int step) {
 std::string PictureRecorder::FormatCaption(const Frame& frame) const {
   char time[48];
   std::snprintf(time, sizeof(time), "t = %.3f s", frame.step * dt_);
-  return frame.caption.empty() ? scene_name_ + "  " + time : std::string(time) + ": " + frame.caption;
+  return frame.caption.empty() ? scene_name_ + "  " + time
+                               : std::string(time) + ": " + frame.caption;
 }
 
 PictureReport PictureRecorder::Finish(const Vec3& camera_direction) {
@@ -114,12 +116,13 @@ PictureReport PictureRecorder::Finish(const Vec3& camera_direction) {
   View view = MakeView(all, camera_direction);
   // Key frames, one PNG each.
   const FrameStyle& key_style = settings_.key_style;
-  view.camera.Fit(key_style.width, key_style.height, key_style.height / 20, CalcTopMargin(key_style));
+  view.camera.Fit(key_style.width, key_style.height, key_style.height / 20,
+                  CalcTopMargin(key_style));
   double ms_render = 0.0, ms_png = 0.0;
   for (size_t k = 0; k < keys_.size(); ++k) {
     Clock::time_point start = Clock::now();
-    const Image image =
-        RenderFrame(keys_[k].snapshot->MakeMeshes(), view.camera, view.ground, FormatCaption(keys_[k]), key_style);
+    const Image image = RenderFrame(keys_[k].snapshot->MakeMeshes(), view.camera, view.ground,
+                                    FormatCaption(keys_[k]), key_style);
     ms_render += MsSince(start);
     char name[32];
     std::snprintf(name, sizeof(name), "key_%02d_", static_cast<int>(k));
@@ -140,19 +143,22 @@ PictureReport PictureRecorder::Finish(const Vec3& camera_direction) {
     Image figure(columns * tile.width, rows * tile.height, tile.background);
     view.camera.Fit(tile.width, tile.height, tile.height / 20, CalcTopMargin(tile));
     for (int k = 0; k < n; ++k)
-      Blit(RenderFrame(keys_[k].snapshot->MakeMeshes(), view.camera, view.ground, FormatCaption(keys_[k]), tile),
+      Blit(RenderFrame(keys_[k].snapshot->MakeMeshes(), view.camera, view.ground,
+                       FormatCaption(keys_[k]), tile),
            (k % columns) * tile.width, (k / columns) * tile.height, figure);
     WritePng(figure, out_dir_ + "/figure.png");
     report.files.push_back(out_dir_ + "/figure.png");
   }
   // The animation.
   const FrameStyle& gif_style = settings_.gif_style;
-  view.camera.Fit(gif_style.width, gif_style.height, gif_style.height / 20, CalcTopMargin(gif_style));
+  view.camera.Fit(gif_style.width, gif_style.height, gif_style.height / 20,
+                  CalcTopMargin(gif_style));
   GifWriter gif(out_dir_ + "/run.gif", settings_.gif_delay_cs);
   double ms_gif_render = 0.0;
   for (const Frame& f : gif_) {
     const Clock::time_point start = Clock::now();
-    const Image image = RenderFrame(f.snapshot->MakeMeshes(), view.camera, view.ground, FormatCaption(f), gif_style);
+    const Image image = RenderFrame(f.snapshot->MakeMeshes(), view.camera, view.ground,
+                                    FormatCaption(f), gif_style);
     ms_gif_render += MsSince(start);
     gif.AddFrame(image);
   }

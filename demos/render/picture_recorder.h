@@ -13,10 +13,10 @@ namespace taut::render {
 
 // Sizes and pacing of the pictures.
 struct PictureSettings {
-  FrameStyle key_style;                              // key frames: 640 x 360
+  FrameStyle key_style;                                    // key frames: 640 x 360
   FrameStyle tile_style{400, 225, 1, true, Vec3::Ones()};  // figure.png tiles
   FrameStyle gif_style{320, 180, 1, false, Vec3::Ones()};  // run.gif frames
-  int gif_frames = 60;  // about this many GIF frames per run
+  int gif_frames = 60;                                     // about this many GIF frames per run
   int gif_delay_cs = 8;
 };
 
@@ -24,11 +24,11 @@ struct PictureSettings {
 struct PictureReport {
   std::vector<std::string> files;
   int key_frames = 0, gif_frames = 0;
-  double ms_capture = 0.0;        // surface extraction during the run, total
-  double ms_render_frame = 0.0;   // mean rasterization of one 640 x 360 key frame
+  double ms_capture = 0.0;       // surface extraction during the run, total
+  double ms_render_frame = 0.0;  // mean rasterization of one 640 x 360 key frame
   double ms_render_gif_frame = 0.0;
-  double ms_write_png = 0.0;      // mean PNG encoding of one key frame
-  double ms_write_gif = 0.0;      // gnuplot's GIF encoding, total
+  double ms_write_png = 0.0;  // mean PNG encoding of one key frame
+  double ms_write_gif = 0.0;  // gnuplot's GIF encoding, total
 };
 
 // Records snapshots while a scene runs and writes the pictures at the end. Rendering happens in
@@ -63,8 +63,8 @@ class PictureRecorder {
 };
 
 // The camera and ground for a set of snapshots: the camera sees every moving body in every
-// snapshot and its shadow (static scenery may be cut off); the ground is the scenes' ground plane (or a floor just below the lowest
-// point) reaching well beyond the bodies.
+// snapshot and its shadow (static scenery may be cut off); the ground is the scenes' ground plane
+// (or a floor just below the lowest point) reaching well beyond the bodies.
 struct View {
   Camera camera;
   std::optional<Ground> ground;

@@ -24,8 +24,8 @@ constexpr double kRigidColour[3] = {0.55, 0.42, 0.30};  // rigid bodies: brown w
 RenderMesh MakeBoxMesh(const Vec3& h) {
   RenderMesh mesh;
   for (int i = 0; i < 8; ++i)
-    mesh.vertices.push_back(Vec3((i & 1) ? h.x() : -h.x(), (i & 2) ? h.y() : -h.y(),
-                                 (i & 4) ? h.z() : -h.z()));
+    mesh.vertices.push_back(
+        Vec3((i & 1) ? h.x() : -h.x(), (i & 2) ? h.y() : -h.y(), (i & 4) ? h.z() : -h.z()));
   // Faces as quads (counter-clockwise seen from outside).
   const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
                            {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
@@ -104,7 +104,8 @@ SceneSnapshot SceneSurfaceExtractor::Extract(const Scene& scene) {
   SceneSnapshot snapshot;
   const DeformableWorld& world = scene.world();
   std::vector<int> embedded(world.num_deformable_bodies(), -1);
-  for (int i = 0; i < scene.num_embedded_surfaces(); ++i) embedded[scene.embedded_surface_body(i)] = i;
+  for (int i = 0; i < scene.num_embedded_surfaces(); ++i)
+    embedded[scene.embedded_surface_body(i)] = i;
   for (int b = 0; b < world.num_deformable_bodies(); ++b) {
     const DeformableBody& body = world.deformable_body(b);
     DeformableState state;

@@ -14,12 +14,12 @@ namespace taut::render {
 
 // A body's surface at one instant, in world coordinates.
 struct RenderMesh {
-  std::string label;                // drawn next to the body; empty: none
-  std::vector<Vec3> vertices;       // [m]
-  std::vector<Triangle> triangles;  // wound outward
+  std::string label;                  // drawn next to the body; empty: none
+  std::vector<Vec3> vertices;         // [m]
+  std::vector<Triangle> triangles;    // wound outward
   Vec3 colour = Vec3(0.8, 0.8, 0.8);  // linear RGB in [0, 1]
-  bool smooth = false;              // vertex normals (scans, spheres); else one normal per face
-  bool scenery = false;             // a static body: drawn, but the camera need not show all of it
+  bool smooth = false;                // vertex normals (scans, spheres); else one normal per face
+  bool scenery = false;  // a static body: drawn, but the camera need not show all of it
 };
 
 // A deformable body at one instant: its surface (shared between snapshots) and node positions.

@@ -1,10 +1,10 @@
 #include "demos/render/text.h"
 
+#include <stb_easy_font.h>
+
 #include <algorithm>
 #include <cmath>
 #include <vector>
-
-#include <stb_easy_font.h>
 
 namespace taut::render {
 
