@@ -19,13 +19,6 @@ Mat3 CalcSymmetricPseudoInverse(const Mat3& m) {
   return eigen.eigenvectors() * inv.asDiagonal() * eigen.eigenvectors().transpose();
 }
 
-// Matrix of a Bullet 3x3.
-Mat3 ToEigenMatrix(const btMatrix3x3& m) {
-  Mat3 out;
-  for (int r = 0; r < 3; ++r)
-    for (int c = 0; c < 3; ++c) out(r, c) = static_cast<double>(m[r][c]);
-  return out;
-}
 }  // namespace
 
 RigidIslandBody::RigidIslandBody(btRigidBody* body) : body_(body) {
@@ -38,7 +31,7 @@ void RigidIslandBody::BeginStep(double h) {
   start_ = body_->getWorldTransform();
   start_linear_ = body_->getLinearVelocity();
   start_angular_ = body_->getAngularVelocity();
-  inverse_inertia_ = ToEigenMatrix(body_->getInvInertiaTensorWorld());
+  inverse_inertia_ = ToEigen(body_->getInvInertiaTensorWorld());
   inertia_ = CalcSymmetricPseudoInverse(inverse_inertia_);
   // Bullet's solver integrates external forces inside the solve (btSequentialImpulseConstraint-
   // Solver::initSolverBody); v* reproduces that impulse for a body taut solves instead.

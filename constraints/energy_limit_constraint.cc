@@ -17,15 +17,10 @@ void CheckElementType(const DeformableBody& body) {
               "(co-rotational hexahedra)");
 }
 
-// Rest volume of every element of the body [m^3].
-std::vector<double> GatherRestVolumes(const TetElementModel* tets, const HexElementModel* hexes) {
-  std::vector<double> volumes;
-  if (tets != nullptr) {
-    for (int e = 0; e < tets->num_elements(); ++e)
-      volumes.push_back(tets->rest().elements[e].volume);
-  } else {
-    for (int e = 0; e < hexes->num_elements(); ++e) volumes.push_back(hexes->rest(e).volume);
-  }
+// Rest volume of every element of the body [m^3], in element order.
+std::vector<double> GatherRestVolumes(const ElementModel& model) {
+  std::vector<double> volumes(model.num_elements());
+  for (int e = 0; e < model.num_elements(); ++e) volumes[e] = model.element_rest_volume(e);
   return volumes;
 }
 }  // namespace
@@ -38,7 +33,7 @@ EnergyLimitConstraint::EnergyLimitConstraint(const DeformableBody& body,
       settings_(settings),
       key_(kEnergyLimitRowKey, source_id) {
   settings_.Validate(body.model().num_elements(), "body '" + body.name() + "' energy limits");
-  u_max_ = CalcElementEnergyLimits(settings_, GatherRestVolumes(tets_, hexes_));
+  u_max_ = CalcElementEnergyLimits(settings_, GatherRestVolumes(body.model()));
 }
 
 double EnergyLimitConstraint::CalcElementEnergy(const VecX& x, int e) const {
