@@ -3,6 +3,7 @@
 #pragma once
 
 #include "constraints/constraint_row.h"
+#include "plugin/element_model.h"
 
 namespace taut {
 
@@ -14,6 +15,15 @@ void AddElementCurvatureBlocks(const Eigen::Matrix<double, 3 * N, 3 * N>& H, dou
   for (int a = 0; a < N; ++a)
     for (int b = 0; b < N; ++b)
       sink.AddBlock(body, nodes[a], nodes[b], weight * H.template block<3, 3>(3 * a, 3 * b));
+}
+
+// The same for an element matrix of run-time size, N = H.rows() / 3 nodes.
+inline void AddElementCurvatureBlocks(const ElementMatrix& H, double weight, int body,
+                                      const int* nodes, CurvatureSink& sink) {
+  const int num_nodes = static_cast<int>(H.rows() / 3);
+  for (int a = 0; a < num_nodes; ++a)
+    for (int b = 0; b < num_nodes; ++b)
+      sink.AddBlock(body, nodes[a], nodes[b], weight * H.block<3, 3>(3 * a, 3 * b));
 }
 
 }  // namespace taut

@@ -8,15 +8,6 @@
 namespace taut {
 
 namespace {
-// Throws unless the body is made of co-rotated tets or hexes.
-void CheckElementType(const DeformableBody& body) {
-  TAUT_DEMAND(dynamic_cast<const TetElementModel*>(&body.model()) != nullptr ||
-                  dynamic_cast<const HexElementModel*>(&body.model()) != nullptr,
-              "body '", body.name(),
-              "': energy limits need a tet body (co-rotational tetrahedra) or a hex body "
-              "(co-rotational hexahedra)");
-}
-
 // Rest volume of every element of the body [m^3], in element order.
 std::vector<double> GatherRestVolumes(const ElementModel& model) {
   std::vector<double> volumes(model.num_elements());
@@ -27,47 +18,28 @@ std::vector<double> GatherRestVolumes(const ElementModel& model) {
 
 EnergyLimitConstraint::EnergyLimitConstraint(const DeformableBody& body,
                                              const EnergyLimitSettings& settings, int source_id)
-    : body_(body),
-      tets_((CheckElementType(body), dynamic_cast<const TetElementModel*>(&body.model()))),
-      hexes_(dynamic_cast<const HexElementModel*>(&body.model())),
-      settings_(settings),
-      key_(kEnergyLimitRowKey, source_id) {
+    : body_(body), settings_(settings), key_(kEnergyLimitRowKey, source_id) {
+  TAUT_DEMAND(body.model().nodes_per_element() <= kMaxRowNodes, "body '", body.name(),
+              "': energy limits need elements of at most ", kMaxRowNodes, " nodes, got ",
+              body.model().nodes_per_element());
   settings_.Validate(body.model().num_elements(), "body '" + body.name() + "' energy limits");
   u_max_ = CalcElementEnergyLimits(settings_, GatherRestVolumes(body.model()));
 }
 
 double EnergyLimitConstraint::CalcElementEnergy(const VecX& x, int e) const {
-  if (tets_ != nullptr)
-    return CalcTetElementEnergy(tets_->rest().elements[e], tets_->lame(),
-                                tets_->GatherElement(x, e));
-  return CalcHexElementEnergy(hexes_->rest(e), hexes_->GatherElement(x, e),
-                              hexes_->rotation_method());
+  return body_.model().CalcElementEnergy(e, x);
 }
 
 void EnergyLimitConstraint::FillRow(const VecX& x, int e, ConstraintRow& row) const {
-  const int* nodes = body_.model().element_nodes(e);
-  if (tets_ != nullptr) {
-    const TetEnergyLimitRow r = CalcTetEnergyLimitRow(tets_->rest().elements[e], tets_->lame(),
-                                                      tets_->GatherElement(x, e), u_max_[e]);
-    row.C = r.C;
-    row.num_nodes = 4;
-    for (int n = 0; n < 4; ++n) {
-      row.nodes[n] = nodes[n];
-      row.J[n] = r.J.segment<3>(3 * n);
-    }
-    return;
-  }
-  // Hex: R recomputed from x, then frozen for the Jacobian (docs/math.md §4.5).
-  const HexRestElement& rest = hexes_->rest(e);
-  const HexNodes xe = hexes_->GatherElement(x, e);
-  const Mat3 R = CalcHexRotation(rest, xe, hexes_->rotation_method());
-  const HexEnergyLimitRow r = CalcHexEnergyLimitRow(rest, xe, R, u_max_[e]);
-  row.C = r.C;
-  row.num_nodes = 8;
-  for (int n = 0; n < 8; ++n) {
-    row.nodes[n] = nodes[n];
-    row.J[n] = r.J.segment<3>(3 * n);
-  }
+  // R recomputed from x, then frozen for the Jacobian J = f_e / U_max (docs/math.md §4.5).
+  const ElementModel& model = body_.model();
+  ElementVectors forces;
+  const double energy = model.CalcElementForces(e, x, forces);
+  row.C = CalcEnergyLimitValue(energy, u_max_[e]);
+  row.num_nodes = model.nodes_per_element();
+  CalcEnergyLimitJacobian(forces.data(), row.num_nodes, u_max_[e], row.J.data());
+  const int* nodes = model.element_nodes(e);
+  for (int n = 0; n < row.num_nodes; ++n) row.nodes[n] = nodes[n];
 }
 
 int EnergyLimitConstraint::AppendRows(const VecX& x, int body_index,
@@ -94,18 +66,11 @@ void EnergyLimitConstraint::AddIslandCurvature(const IslandIterate& iterate,
     const ConstraintRow& row = rows[c];
     if (!key_.Owns(row.key) || !(weights[c] > 0.0)) continue;
     const int e = static_cast<int>(key_.Unpack(row.key)[0]);
-    const VecX& x = iterate.x(row.body);
-    const int* nodes = body_.model().element_nodes(e);
-    if (tets_ != nullptr) {
-      const Mat12 H = CalcTetEnergyLimitCurvature(tets_->rest().elements[e], tets_->lame(),
-                                                  tets_->GatherElement(x, e), u_max_[e]);
-      AddElementCurvatureBlocks<4>(H, weights[c], row.body, nodes, sink);
-      continue;
-    }
-    const HexNodes xe = hexes_->GatherElement(x, e);
-    const Mat3 R = CalcHexRotation(hexes_->rest(e), xe, hexes_->rotation_method());
-    const Mat24 H = CalcHexEnergyLimitCurvature(hexes_->rest(e), R, u_max_[e]);
-    AddElementCurvatureBlocks<8>(H, weights[c], row.body, nodes, sink);
+    // -d^2 C/dx^2 = K_e(R)/U_max with R frozen at the iterate.
+    ElementMatrix H;
+    body_.model().CalcElementStiffness(e, iterate.x(row.body), H);
+    H /= u_max_[e];
+    AddElementCurvatureBlocks(H, weights[c], row.body, body_.model().element_nodes(e), sink);
   }
 }
 

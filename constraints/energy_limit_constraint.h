@@ -1,4 +1,4 @@
-// Energy limits of one tet or hex body as a source of SQP rows (paper B eq. 14;
+// Energy limits of one deformable body as a source of SQP rows (paper B eq. 14;
 // docs/math.md §4-§5).
 #pragma once
 
@@ -8,17 +8,16 @@
 #include "constraints/energy_limit_rows.h"
 #include "constraints/energy_limits.h"
 #include "constraints/row_key_layouts.h"
-#include "plugin/hex_element_model.h"
-#include "plugin/tet_element_model.h"
 
 namespace taut {
 
-// Emits one row C = 1 - U_e/U_max,e per element (tet: 4 nodes, exact gradient; hex: 8 nodes,
-// J = f_e/U_max with the element rotation frozen at x, docs/math.md §4.5) whose C is below the
-// activation margin.
+// Emits one row C = 1 - U_e/U_max,e per element whose C is below the activation margin, over the
+// element's nodes with J = f_e/U_max (ElementModel::CalcElementForces: the element rotation
+// frozen at x, docs/math.md §4.5; for tets the exact gradient).
 class EnergyLimitConstraint final : public BodyConstraintSource {
  public:
-  // `body` must be a tet or hex body; settings are validated (throws InputError naming the body).
+  // The body's elements must have at most kMaxRowNodes nodes; settings are validated (throws
+  // InputError naming the body).
   // `source_id` (< 2^16, else InputError) makes row keys unique among the sources of a world.
   EnergyLimitConstraint(const DeformableBody& body, const EnergyLimitSettings& settings,
                         int source_id);
@@ -27,8 +26,8 @@ class EnergyLimitConstraint final : public BodyConstraintSource {
   int AppendRows(const VecX& x, int body_index, std::vector<ConstraintRow>& rows) override;
   double CalcMaxViolation(const VecX& x) const override;
   double CalcViolationSum(const VecX& x) const override;
-  // Adds weights[c] K_e(R)/U_max,e (R frozen at the iterate; energy_limit_rows.h) for each row
-  // of this source, the element decoded from the key.
+  // Adds weights[c] K_e(R)/U_max,e (ElementModel::CalcElementStiffness, R frozen at the iterate;
+  // energy_limit_rows.h) for each row of this source, the element decoded from the key.
   void AddIslandCurvature(const IslandIterate& iterate, const ConstraintRow* rows,
                           const double* weights, int count, CurvatureSink& sink) const override;
 
@@ -47,8 +46,6 @@ class EnergyLimitConstraint final : public BodyConstraintSource {
   void FillRow(const VecX& x, int e, ConstraintRow& row) const;
 
   const DeformableBody& body_;
-  const TetElementModel* tets_;  // exactly one of tets_, hexes_ is set
-  const HexElementModel* hexes_;
   EnergyLimitSettings settings_;
   std::vector<double> u_max_;  // U_max,e [J], +inf = unlimited
   RowKeyPacker<1> key_;        // kEnergyLimitRowKey with this source's id

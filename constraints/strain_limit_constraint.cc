@@ -11,7 +11,7 @@ namespace taut {
 
 namespace {
 const TetElementModel& AsTets(const DeformableBody& body) {
-  const auto* tets = dynamic_cast<const TetElementModel*>(&body.model());
+  const TetElementModel* tets = body.model().tet_model();
   TAUT_DEMAND(tets != nullptr, "body '", body.name(),
               "': strain limits need a tet body (co-rotational tetrahedra)");
   return *tets;

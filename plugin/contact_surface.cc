@@ -4,9 +4,6 @@
 #include <map>
 #include <tuple>
 
-#include "plugin/hex_element_model.h"
-#include "plugin/tet_element_model.h"
-
 namespace taut {
 
 namespace {
@@ -105,12 +102,7 @@ ContactSurface MakeTetEmbeddedContactSurface(const TetMesh& mesh,
 
 ContactSurface MakeEmbeddedBodyContactSurface(const ElementModel& model,
                                               const SurfaceMesh& surface) {
-  if (const auto* tets = dynamic_cast<const TetElementModel*>(&model))
-    return MakeTetEmbeddedContactSurface(tets->mesh(), EmbedSurfaceInTets(tets->mesh(), surface));
-  if (const auto* hexes = dynamic_cast<const HexElementModel*>(&model))
-    return MakeEmbeddedContactSurface(hexes->lattice(), EmbedSurface(hexes->lattice(), surface));
-  throw InputError(
-      internal::Concat(surface.source, ": surfaces can only be embedded in tet or hex bodies"));
+  return model.MakeEmbeddedContactSurface(surface);
 }
 
 std::vector<Vec3> CalcContactPointPositions(const ContactSurface& surface, const VecX& x) {
@@ -128,13 +120,7 @@ std::vector<Vec3> CalcContactPointPositions(const ContactSurface& surface, const
 }
 
 ContactSurface MakeBodyContactSurface(const ElementModel& model) {
-  if (const auto* tets = dynamic_cast<const TetElementModel*>(&model))
-    return MakeTetContactSurface(tets->mesh());
-  if (const auto* hexes = dynamic_cast<const HexElementModel*>(&model))
-    return MakeHexContactSurface(hexes->lattice());
-  ContactSurface all;
-  for (int i = 0; i < model.num_nodes(); ++i) all.points.push_back(NodePoint(i));
-  return all;
+  return model.MakeContactSurface();
 }
 
 }  // namespace taut

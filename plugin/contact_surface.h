@@ -41,14 +41,15 @@ ContactSurface MakeEmbeddedContactSurface(const HexLattice& lattice,
 // The vertices and triangles of a surface embedded in the tet mesh (4-node points).
 ContactSurface MakeTetEmbeddedContactSurface(const TetMesh& mesh,
                                              const TetEmbeddedSurface& surface);
-// `surface` (in the rest frame) embedded in a tet or hex body's model: EmbedSurfaceInTets or
-// EmbedSurface, then the function above or MakeEmbeddedContactSurface. Throws InputError for
-// another model or a surface that cannot be embedded.
+// `surface` (in the rest frame) embedded in a body's model (ElementModel::
+// MakeEmbeddedContactSurface: for tets EmbedSurfaceInTets and the function above, for hexes
+// EmbedSurface and MakeEmbeddedContactSurface). Throws InputError for a surface that cannot be
+// embedded.
 ContactSurface MakeEmbeddedBodyContactSurface(const ElementModel& model,
                                               const SurfaceMesh& surface);
 
-// The boundary of a tet or hex body's model (the two functions above); every node for other
-// models (points without triangles).
+// The boundary of a body's model (ElementModel::MakeContactSurface: MakeTetContactSurface or
+// MakeHexContactSurface).
 ContactSurface MakeBodyContactSurface(const ElementModel& model);
 
 // Position of point p for node positions x (3N).

@@ -3,9 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "plugin/hex_element_model.h"
-#include "plugin/tet_element_model.h"
-
 namespace taut {
 namespace {
 
@@ -39,16 +36,6 @@ DeformableBody::DeformableBody(std::unique_ptr<ElementModel> model,
   for (int i = 0; i < n; ++i)
     TAUT_DEMAND(mass_[i] > 0.0, "body '", name(), "': node ", i,
                 " belongs to no element (zero mass); remove unused nodes from the mesh");
-}
-
-const TetMesh* DeformableBody::rest_tet_mesh() const {
-  const auto* tets = dynamic_cast<const TetElementModel*>(model_.get());
-  return tets != nullptr ? &tets->mesh() : nullptr;
-}
-
-const HexLattice* DeformableBody::rest_hex_lattice() const {
-  const auto* hexes = dynamic_cast<const HexElementModel*>(model_.get());
-  return hexes != nullptr ? &hexes->lattice() : nullptr;
 }
 
 void DeformableBody::set_x(const VecX& x) {

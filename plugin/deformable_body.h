@@ -34,9 +34,9 @@ class DeformableBody {
   const ElementModel& model() const { return *model_; }
   ElementModel& mutable_model() { return *model_; }
   // The rest mesh of a tet body (node positions [m]), null for other element models.
-  const TetMesh* rest_tet_mesh() const;
+  const TetMesh* rest_tet_mesh() const { return model_->tet_mesh(); }
   // The rest lattice of a hex body (node positions [m]), null for other element models.
-  const HexLattice* rest_hex_lattice() const;
+  const HexLattice* rest_hex_lattice() const { return model_->hex_lattice(); }
   // Rest volume of element e [m^3].
   double element_rest_volume(int e) const { return model_->element_rest_volume(e); }
   int num_nodes() const { return model_->num_nodes(); }

@@ -1,14 +1,34 @@
-// What the implicit step needs from a body's elements (tets now, hexes later).
+// What the implicit step, the constraints and the contact code need from a body's elements, in
+// terms of no particular element type (tets, hexes).
 #pragma once
 
+#include <array>
 #include <vector>
 
 #include "plugin/common.h"
 
 namespace taut {
 
-// The elastic elements of one body. One virtual call per body and stage, never per element;
-// implementations loop over their elements with fixed-size kernels.
+struct ContactSurface;
+struct HexLattice;
+struct SurfaceMesh;
+struct TetMesh;
+class TetElementModel;
+
+// Most nodes one element has (a hex).
+inline constexpr int kMaxElementNodes = 8;
+// Per-node vectors of one element (the first nodes_per_element() entries are used).
+using ElementVectors = std::array<Vec3, kMaxElementNodes>;
+// A matrix over one element's 3 nodes_per_element() coordinates, node-major xyz, stored in place
+// (no heap allocation).
+using ElementMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor,
+                                    3 * kMaxElementNodes, 3 * kMaxElementNodes>;
+
+// The elastic elements of one body. Every element e has a rotation R_e (its co-rotated frame) and
+// the energy U_e = 1/2 u^T K0_e u of u = R_e^T x_e - X_e (X_e its rest nodes), so with R_e held
+//   f_e = -dU_e/dx = -R_e K0_e (R_e^T x_e - X_e),   K_e = -df_e/dx = R_e K0_e R_e^T.
+// Whole-body calls are one virtual call per body and stage, never per element; implementations
+// loop over their elements with fixed-size kernels (element_model_impl.h).
 class ElementModel {
  public:
   virtual ~ElementModel() = default;
@@ -17,7 +37,7 @@ class ElementModel {
   virtual int num_nodes() const = 0;
   // Number of elements.
   virtual int num_elements() const = 0;
-  // Nodes per element (4 for tets, 8 for hexes).
+  // Nodes per element (4 for tets, 8 for hexes), at most kMaxElementNodes.
   virtual int nodes_per_element() const = 0;
   // Node indices of element e (nodes_per_element() of them).
   virtual const int* element_nodes(int e) const = 0;
@@ -28,9 +48,14 @@ class ElementModel {
   // Lumped mass per node from the density [kg]; `mass` is resized to num_nodes().
   virtual void CalcLumpedMass(double density, VecX& mass) const = 0;
 
+  // --- Whole body ---
   // Updates the element rotations at x (3N) and adds the elastic forces into f (3N) [N].
   // Returns the elastic energy [J].
   virtual double UpdateRotationsAndAddForces(const VecX& x, VecX& f) = 0;
+  // f += -R K0 (R^T x - X) of every element at x (3N) with the rotations of the last update held
+  // [N]: the force whose Jacobian is -K of AddScaledStiffness(Times); at the update's x it is the
+  // force UpdateRotationsAndAddForces added.
+  virtual void AddHeldRotationForces(const VecX& x, VecX& f) const = 0;
   // values[index_map[...]] += scale * K_e for every element with the frozen rotations of the last
   // update. index_map has nodes_per_element()^2 * 9 entries per element (block (a,b) row-major
   // blocks, entries column-major inside a block); -1 skips an entry.
@@ -40,6 +65,32 @@ class ElementModel {
   virtual void AddScaledStiffnessTimes(double scale, const VecX& v, VecX& out) const = 0;
   // Elastic energy at x with rotations recomputed at x [J].
   virtual double CalcEnergy(const VecX& x) const = 0;
+
+  // --- One element e at body positions x (3N), its rotation R_e recomputed at x ---
+  // U_e [J].
+  virtual double CalcElementEnergy(int e, const VecX& x) const = 0;
+  // Returns U_e [J] and sets forces[a] = f_e of node element_nodes(e)[a] [N] (R_e held).
+  virtual double CalcElementForces(int e, const VecX& x, ElementVectors& forces) const = 0;
+  // K = R_e K0_e R_e^T (3n x 3n for n = nodes_per_element(), symmetric PSD) [N/m].
+  virtual void CalcElementStiffness(int e, const VecX& x, ElementMatrix& K) const = 0;
+  // Deformation gradient dx/dX at the element centre (constant over a tet) [-].
+  virtual Mat3 CalcElementDeformationGradient(int e, const VecX& x) const = 0;
+
+  // --- Contact ---
+  // The body's boundary as contact points (its boundary nodes) and outward triangles.
+  virtual ContactSurface MakeContactSurface() const = 0;
+  // `surface` (in the rest frame) embedded in the elements: one point per vertex, a weighted
+  // combination of the nodes of the element holding it. Throws InputError when a vertex lies in
+  // no element.
+  virtual ContactSurface MakeEmbeddedContactSurface(const SurfaceMesh& surface) const = 0;
+
+  // --- The concrete geometry, only for callers that need it (writers, tet-only limits) ---
+  // The rest tet mesh of a tet model, else null.
+  virtual const TetMesh* tet_mesh() const { return nullptr; }
+  // The rest hex lattice of a hex model, else null.
+  virtual const HexLattice* hex_lattice() const { return nullptr; }
+  // The model itself when it is made of co-rotated tets (its rest data r_n), else null.
+  virtual const TetElementModel* tet_model() const { return nullptr; }
 };
 
 }  // namespace taut

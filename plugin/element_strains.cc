@@ -1,8 +1,6 @@
 #include "plugin/element_strains.h"
 
-#include "plugin/hex_element_model.h"
 #include "plugin/signed_svd.h"
-#include "plugin/tet_element_model.h"
 
 namespace taut {
 namespace {
@@ -16,35 +14,16 @@ ElementStrain MakeElementStrain(const Mat3& F, const Mat3& axes, double energy) 
   return strain;
 }
 
-// Element e of a tet body at x.
-ElementStrain CalcTetStrain(const TetElementModel& tets, const VecX& x, int e, const Mat3& axes) {
-  const TetRestElement& rest = tets.rest().elements[e];
-  const Mat3 F = CalcTetDeformationGradient(rest, tets.GatherElement(x, e));
-  return MakeElementStrain(F, axes,
-                           CalcCorotatedTetEnergy(rest, tets.lame(), F, CalcPolarRotation(F)));
-}
-
-// Element e of a hex body at x.
-ElementStrain CalcHexStrain(const HexElementModel& hexes, const VecX& x, int e, const Mat3& axes) {
-  const HexRestElement& rest = hexes.rest(e);
-  const HexNodes xe = hexes.GatherElement(x, e);
-  const Mat3 R = CalcHexRotation(rest, xe, hexes.rotation_method());
-  return MakeElementStrain(CalcHexCenterDeformationGradient(rest, xe), axes,
-                           CalcCorotatedHexEnergy(rest, xe, R));
-}
-
-// Every element, the axes of element e being axes[e] (num_axes == num_elements) or axes[0].
+// Every element, the axes of element e being axes[e] (num_axes == num_elements) or axes[0]: F at
+// the element centre and U_e, both at the body's x.
 std::vector<ElementStrain> CalcStrains(const DeformableBody& body, const Mat3* axes,
                                        std::size_t num_axes) {
-  const auto* tets = dynamic_cast<const TetElementModel*>(&body.model());
-  const auto* hexes = dynamic_cast<const HexElementModel*>(&body.model());
-  TAUT_DEMAND(tets != nullptr || hexes != nullptr, "body '", body.name(),
-              "': element strains need a tet or hex body");
+  const ElementModel& model = body.model();
   std::vector<ElementStrain> strains(body.num_elements());
   for (int e = 0; e < body.num_elements(); ++e) {
     const Mat3& q = axes[num_axes == 1 ? 0 : e];
-    strains[e] = tets != nullptr ? CalcTetStrain(*tets, body.x(), e, q)
-                                 : CalcHexStrain(*hexes, body.x(), e, q);
+    strains[e] = MakeElementStrain(model.CalcElementDeformationGradient(e, body.x()), q,
+                                   model.CalcElementEnergy(e, body.x()));
   }
   return strains;
 }

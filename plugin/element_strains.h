@@ -20,10 +20,10 @@ struct ElementStrain {
   double energy = 0.0;
 };
 
-// The strain of every element of a tet or hex body at its current positions x. Tets: F of the
-// linear tet. Hexes: F = G(0) at the element centre (exact for an affine deformation); the energy
-// with the body's rotation method, as in ElementModel::CalcEnergy. `axes`: limit axes as columns
-// (e.g. StrainLimitSettings::frame). Throws InputError for another element model.
+// The strain of every element of a body at its current positions x: F =
+// ElementModel::CalcElementDeformationGradient (tets: F of the linear tet; hexes: G(0) at the
+// element centre, exact for an affine deformation) and U_e = ElementModel::CalcElementEnergy.
+// `axes`: limit axes as columns (e.g. StrainLimitSettings::frame).
 std::vector<ElementStrain> CalcElementStrains(const DeformableBody& body,
                                               const Mat3& axes = Mat3::Identity());
 

@@ -8,6 +8,7 @@
 #include "constraints/sqp_solver.h"
 #include "plugin/box_tet_mesher.h"
 #include "plugin/hex_element_model.h"
+#include "plugin/tet_element_model.h"
 #include "tests/test_utils.h"
 
 namespace taut {

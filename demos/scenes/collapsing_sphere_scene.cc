@@ -1,9 +1,9 @@
 #include "demos/scenes/collapsing_sphere_scene.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
-#include "plugin/hex_element_model.h"
 #include "plugin/hex_shapes.h"
 
 namespace taut {
@@ -74,13 +74,16 @@ double CollapsingSphereScene::CalcTop(int s) const {
 
 double CollapsingSphereScene::CalcMinVolumeRatio(int s) const {
   const DeformableBody& body = world().deformable_body(s);
-  const auto& hexes = dynamic_cast<const HexElementModel&>(body.model());
-  const HexLattice& lattice = hexes.lattice();
+  const HexLattice* lattice = body.rest_hex_lattice();
+  TAUT_DEMAND(lattice != nullptr, "collapsing sphere scene: body '", body.name(),
+              "' is not a hex body");
   double ratio = HUGE_VAL;
-  for (int e = 0; e < hexes.num_elements(); ++e) {
-    const HexNodes x = hexes.GatherElement(body.x(), e);
-    HexNodes X;
-    for (int a = 0; a < 8; ++a) X[a] = lattice.nodes[lattice.hexes[e][a]];
+  for (const auto& hex : lattice->hexes) {
+    std::array<Vec3, 8> x, X;
+    for (int a = 0; a < 8; ++a) {
+      x[a] = body.node_position(hex[a]);
+      X[a] = lattice->nodes[hex[a]];
+    }
     // J = det(dx/ds) / det(dX/ds) at each Gauss point.
     for (int q = 0; q < 8; ++q) {
       const Vec3 gauss = HexGaussPoint(q);

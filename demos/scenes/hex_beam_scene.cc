@@ -57,11 +57,9 @@ Vec3 HexBeamScene::CalcTipDisplacement(int b) const {
 
 double HexBeamScene::CalcMaxElementEnergy(int b) const {
   const DeformableBody& body = world().deformable_body(b);
-  const auto& hexes = dynamic_cast<const HexElementModel&>(body.model());
   double energy = 0.0;
-  for (int e = 0; e < hexes.num_elements(); ++e)
-    energy = std::max(energy, CalcHexElementEnergy(hexes.rest(e), hexes.GatherElement(body.x(), e),
-                                                   hexes.rotation_method()));
+  for (int e = 0; e < body.num_elements(); ++e)
+    energy = std::max(energy, body.model().CalcElementEnergy(e, body.x()));
   return energy;
 }
 

@@ -2,8 +2,6 @@
 
 #include <cstring>
 
-#include "plugin/hex_element_model.h"
-#include "plugin/tet_element_model.h"
 #include "plugin/vtk_hex_writer.h"
 #include "plugin/vtk_writer.h"
 
@@ -20,17 +18,17 @@ void Scene::WriteVtkFrame(const std::string& dir, int frame, double time) const 
   if (time < 0.0) time = frame;
   for (int b = 0; b < world().num_deformable_bodies(); ++b) {
     const DeformableBody& body = world().deformable_body(b);
-    const auto* tets = dynamic_cast<const TetElementModel*>(&body.model());
-    const auto* hexes = dynamic_cast<const HexElementModel*>(&body.model());
-    if (tets == nullptr && hexes == nullptr) continue;
+    const TetMesh* mesh = body.rest_tet_mesh();
+    const HexLattice* lattice = body.rest_hex_lattice();
+    if (mesh == nullptr && lattice == nullptr) continue;
     std::vector<Vec3> positions(body.num_nodes());
     for (int i = 0; i < body.num_nodes(); ++i) positions[i] = body.node_position(i);
     char name[64];
     std::snprintf(name, sizeof(name), "_%06d.vtk", frame);
-    if (tets != nullptr) {
-      WriteVtkMesh(dir + "/" + body.name() + name, tets->mesh(), &positions);
+    if (mesh != nullptr) {
+      WriteVtkMesh(dir + "/" + body.name() + name, *mesh, &positions);
     } else {
-      WriteVtkHexLattice(dir + "/" + body.name() + name, hexes->lattice(), &positions);
+      WriteVtkHexLattice(dir + "/" + body.name() + name, *lattice, &positions);
     }
     vtk_series_.Add(dir, body.name(), body.name() + name, time);
   }

@@ -6,8 +6,6 @@
 #include "demos/tools/stress/stress_bodies.h"
 #include "demos/tools/stress/stress_cells.h"
 #include "demos/tools/stress/stress_monitor.h"
-#include "plugin/hex_element_model.h"
-#include "plugin/tet_element_model.h"
 
 namespace taut::stress {
 
@@ -28,10 +26,11 @@ double CalcHeight(const DeformableBody& body) {
 
 // Inverted elements of a tet or hex body at its current positions.
 int CountInvertedElements(const DeformableBody& body) {
-  if (const auto* tets = dynamic_cast<const TetElementModel*>(&body.model()))
-    return CalcTetVolumeStats(tets->mesh(), body.x()).inverted;
-  const auto& hexes = dynamic_cast<const HexElementModel&>(body.model());
-  return CountInvertedHexes(hexes.lattice(), body.x());
+  if (const TetMesh* mesh = body.rest_tet_mesh())
+    return CalcTetVolumeStats(*mesh, body.x()).inverted;
+  const HexLattice* lattice = body.rest_hex_lattice();
+  TAUT_DEMAND(lattice != nullptr, "body '", body.name(), "' is neither a tet nor a hex body");
+  return CountInvertedHexes(*lattice, body.x());
 }
 }  // namespace
 
@@ -45,11 +44,11 @@ void RunDropCell(const DropParams& params, CellResult& result) {
   VecX v = VecX::Zero(3 * cube->num_nodes());
   for (int i = 0; i < cube->num_nodes(); ++i) v[3 * i + 2] = -params.speed;
   cube->set_v(v);
-  const auto* tets = dynamic_cast<const TetElementModel*>(&cube->model());
+  const TetMesh* tet_mesh = cube->rest_tet_mesh();
   // Surface nodes carry the contact rows (tets: boundary nodes; hexes: every node).
   std::vector<int> surface;
-  if (tets != nullptr) {
-    surface = CalcBoundaryNodes(tets->mesh());
+  if (tet_mesh != nullptr) {
+    surface = CalcBoundaryNodes(*tet_mesh);
   } else {
     for (int i = 0; i < cube->num_nodes(); ++i) surface.push_back(i);
   }
@@ -63,9 +62,9 @@ void RunDropCell(const DropParams& params, CellResult& result) {
     if (landed) rebound = std::max(rebound, gap);
     for (int i : surface)
       surface_penetration = std::max(surface_penetration, -cube->node_position(i).z());
-    if (tets != nullptr)
+    if (tet_mesh != nullptr)
       min_volume_ratio =
-          std::min(min_volume_ratio, CalcTetVolumeStats(tets->mesh(), cube->x()).min_volume_ratio);
+          std::min(min_volume_ratio, CalcTetVolumeStats(*tet_mesh, cube->x()).min_volume_ratio);
   });
   StandardTolerances tolerances;
   tolerances.penetration = params.penetration_tolerance;
@@ -75,7 +74,7 @@ void RunDropCell(const DropParams& params, CellResult& result) {
                    kDensity * kGravity * kSide / (2.0 * params.youngs_modulus));
   result.AddFigure("surface node penetration [m]", surface_penetration);
   result.AddFigure("rebound [m]", rebound);
-  if (tets != nullptr) result.AddFigure("min tet volume ratio", min_volume_ratio);
+  if (tet_mesh != nullptr) result.AddFigure("min tet volume ratio", min_volume_ratio);
   result.AddFigure("inverted at end", CountInvertedElements(*cube));
 }
 
@@ -110,9 +109,9 @@ void RunRecoveryCell(const RecoveryParams& params, CellResult& result) {
       recovered_at = (step + 1) * params.h;
   });
   monitor.AddStandardChecks(result, StandardTolerances());
-  if (const auto* tets = dynamic_cast<const TetElementModel*>(&cube->model()))
+  if (const TetMesh* tet_mesh = cube->rest_tet_mesh())
     result.AddCheck("|volume / rest - 1|",
-                    std::abs(CalcTetVolumeStats(tets->mesh(), cube->x()).volume_ratio - 1.0),
+                    std::abs(CalcTetVolumeStats(*tet_mesh, cube->x()).volume_ratio - 1.0),
                     params.volume_tolerance);
   result.AddCheck("inverted at end", CountInvertedElements(*cube), 0.0);
   result.AddCheck("shape error / side", CalcShapeError(rest, cube->x(), cube->mass(), kSide),

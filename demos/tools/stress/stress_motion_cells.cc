@@ -7,7 +7,6 @@
 #include "demos/tools/stress/stress_cells.h"
 #include "demos/tools/stress/stress_monitor.h"
 #include "plugin/box_tet_mesher.h"
-#include "plugin/tet_element_model.h"
 
 namespace taut::stress {
 
@@ -38,8 +37,9 @@ void RunSpinCell(const SpinParams& params, CellResult& result) {
   result.AddCheck("max |P - P0| / (m (v + w side))", P_drift, 1e-9);
   result.AddFigure("kinetic energy kept", cube->CalcKineticEnergy() / kinetic0);
   result.AddFigure("rotation per step [rad]", params.omega * params.h);
-  const auto& tets = dynamic_cast<const TetElementModel&>(cube->model());
-  result.AddFigure("volume / rest at end", CalcTetVolumeStats(tets.mesh(), cube->x()).volume_ratio);
+  const TetMesh* mesh = cube->rest_tet_mesh();
+  TAUT_DEMAND(mesh != nullptr, "spin cell: the spinner must be a tet body");
+  result.AddFigure("volume / rest at end", CalcTetVolumeStats(*mesh, cube->x()).volume_ratio);
 }
 
 void RunMassRatioCell(const MassRatioParams& params, CellResult& result) {

@@ -1,0 +1,213 @@
+// The ElementModel overrides once for every element type: loops over the elements that gather
+// an element's nodes, call the per-element kernels of `Traits` and scatter the results.
+//
+// `Traits` (tet_element_traits.h, hex_element_traits.h) supplies, for an element e of the body's
+// rest data `data` (node positions x of the element, Nodes = std::array<Vec3, kNodes>):
+//   kNodes                          nodes per element
+//   Mesh, RestData, Frame           rest geometry; immutable rest data; what one rotation update
+//                                   derives from x (at least the rotation R)
+//   Elements(mesh)                  the node indices of every element
+//   Volume(data, e)                 rest volume [m^3]
+//   CalcFrame(data, e, x)           R of the element at x (and what the kernels reuse with it)
+//   CalcEnergy(data, e, x, frame)   U_e [J];  CalcForces(data, e, x, frame): f_e = -dU_e/dx [N]
+//   RestStiffnessBlock(data, e, a, b)   K0_ab [N/m];  MultiplyRestStiffness(data, e, w): K0 w
+//   CalcFrozenStiffness(data, e, R)     R K0 R^T [N/m]
+//   CalcDeformationGradient(data, e, x) dx/dX at the element centre
+//   MakeContactSurface(mesh), MakeEmbeddedContactSurface(mesh, surface)
+#pragma once
+
+#include <memory>
+#include <utility>
+#include <vector>
+
+#include "plugin/contact_surface.h"
+#include "plugin/element_model.h"
+
+namespace taut {
+
+template <typename Traits>
+class ElementModelImpl : public ElementModel {
+ public:
+  static constexpr int kNodes = Traits::kNodes;
+  using Mesh = typename Traits::Mesh;
+  using RestData = typename Traits::RestData;
+  using Nodes = std::array<Vec3, kNodes>;
+  static_assert(kNodes <= kMaxElementNodes, "ElementVectors cannot hold the element's nodes");
+
+  int num_nodes() const final { return static_cast<int>(mesh_->nodes.size()); }
+  int num_elements() const final { return static_cast<int>(Traits::Elements(*mesh_).size()); }
+  int nodes_per_element() const final { return kNodes; }
+  const int* element_nodes(int e) const final { return Traits::Elements(*mesh_)[e].data(); }
+  const VecX& rest_positions() const final { return rest_positions_; }
+  double element_rest_volume(int e) const final { return Traits::Volume(data_, e); }
+  void CalcLumpedMass(double density, VecX& mass) const final;
+
+  double UpdateRotationsAndAddForces(const VecX& x, VecX& f) final;
+  void AddHeldRotationForces(const VecX& x, VecX& f) const final;
+  void AddScaledStiffness(double scale, const std::vector<int>& index_map,
+                          double* values) const final;
+  void AddScaledStiffnessTimes(double scale, const VecX& v, VecX& out) const final;
+  double CalcEnergy(const VecX& x) const final;
+
+  double CalcElementEnergy(int e, const VecX& x) const final;
+  double CalcElementForces(int e, const VecX& x, ElementVectors& forces) const final;
+  void CalcElementStiffness(int e, const VecX& x, ElementMatrix& K) const final;
+  Mat3 CalcElementDeformationGradient(int e, const VecX& x) const final;
+
+  ContactSurface MakeContactSurface() const final { return Traits::MakeContactSurface(*mesh_); }
+  ContactSurface MakeEmbeddedContactSurface(const SurfaceMesh& surface) const final {
+    return Traits::MakeEmbeddedContactSurface(*mesh_, surface);
+  }
+
+  // Rotation of element e from the last UpdateRotationsAndAddForces.
+  const Mat3& rotation(int e) const { return rotations_[e]; }
+  // Node positions of element e gathered from x (3N).
+  Nodes GatherElement(const VecX& x, int e) const;
+
+ protected:
+  // `data` must have been computed from `mesh` (and validated it).
+  ElementModelImpl(std::shared_ptr<const Mesh> mesh, RestData data);
+
+  const Mesh& geometry() const { return *mesh_; }
+  const RestData& rest_data() const { return data_; }
+
+ private:
+  // f(node of a) += forces[a] for the nodes of element e.
+  void ScatterElement(int e, const Nodes& forces, VecX& f) const;
+
+  std::shared_ptr<const Mesh> mesh_;
+  RestData data_;
+  VecX rest_positions_;
+  std::vector<Mat3> rotations_;  // (num_elements)
+};
+
+template <typename Traits>
+ElementModelImpl<Traits>::ElementModelImpl(std::shared_ptr<const Mesh> mesh, RestData data)
+    : mesh_(std::move(mesh)), data_(std::move(data)) {
+  rest_positions_.resize(3 * num_nodes());
+  for (int i = 0; i < num_nodes(); ++i) rest_positions_.segment<3>(3 * i) = mesh_->nodes[i];
+  rotations_.assign(num_elements(), Mat3::Identity());
+}
+
+template <typename Traits>
+auto ElementModelImpl<Traits>::GatherElement(const VecX& x, int e) const -> Nodes {
+  const auto& element = Traits::Elements(*mesh_)[e];
+  Nodes xe;
+  for (int a = 0; a < kNodes; ++a) xe[a] = x.template segment<3>(3 * element[a]);
+  return xe;
+}
+
+template <typename Traits>
+void ElementModelImpl<Traits>::ScatterElement(int e, const Nodes& forces, VecX& f) const {
+  const auto& element = Traits::Elements(*mesh_)[e];
+  for (int a = 0; a < kNodes; ++a) f.template segment<3>(3 * element[a]) += forces[a];
+}
+
+template <typename Traits>
+void ElementModelImpl<Traits>::CalcLumpedMass(double density, VecX& mass) const {
+  // Each element gives 1/kNodes of its mass rho V to each of its nodes.
+  constexpr double kShare = 1.0 / kNodes;
+  mass.setZero(num_nodes());
+  for (int e = 0; e < num_elements(); ++e)
+    for (int n : Traits::Elements(*mesh_)[e])
+      mass[n] += kShare * density * Traits::Volume(data_, e);
+}
+
+template <typename Traits>
+double ElementModelImpl<Traits>::UpdateRotationsAndAddForces(const VecX& x, VecX& f) {
+  double energy = 0.0;
+  for (int e = 0; e < num_elements(); ++e) {
+    // gather -> local (R, forces, energy) -> scatter
+    const Nodes xe = GatherElement(x, e);
+    const typename Traits::Frame frame = Traits::CalcFrame(data_, e, xe);
+    rotations_[e] = frame.R;
+    const Nodes fe = Traits::CalcForces(data_, e, xe, frame);
+    energy += Traits::CalcEnergy(data_, e, xe, frame);
+    ScatterElement(e, fe, f);
+  }
+  return energy;
+}
+
+template <typename Traits>
+void ElementModelImpl<Traits>::AddHeldRotationForces(const VecX& x, VecX& f) const {
+  for (int e = 0; e < num_elements(); ++e) {
+    // f_e = -R K0 (R^T x_e - X_e).
+    const Mat3& R = rotations_[e];
+    const Nodes xe = GatherElement(x, e), X = GatherElement(rest_positions_, e);
+    Nodes u;
+    for (int b = 0; b < kNodes; ++b) u[b] = R.transpose() * xe[b] - X[b];
+    const Nodes K0u = Traits::MultiplyRestStiffness(data_, e, u);
+    Nodes fe;
+    for (int a = 0; a < kNodes; ++a) fe[a] = -(R * K0u[a]);
+    ScatterElement(e, fe, f);
+  }
+}
+
+template <typename Traits>
+void ElementModelImpl<Traits>::AddScaledStiffness(double scale, const std::vector<int>& index_map,
+                                                  double* values) const {
+  constexpr int kEntries = 9 * kNodes * kNodes;
+  for (int e = 0; e < num_elements(); ++e) {
+    const Mat3& R = rotations_[e];
+    const int* map = index_map.data() + kEntries * e;
+    for (int a = 0; a < kNodes; ++a) {
+      for (int b = 0; b < kNodes; ++b, map += 9) {
+        // Block (a,b) of R K0 R^T, entries column-major.
+        const Mat3 K = scale * (R * Traits::RestStiffnessBlock(data_, e, a, b) * R.transpose());
+        for (int k = 0; k < 9; ++k)
+          if (map[k] >= 0) values[map[k]] += K.data()[k];
+      }
+    }
+  }
+}
+
+template <typename Traits>
+void ElementModelImpl<Traits>::AddScaledStiffnessTimes(double scale, const VecX& v,
+                                                       VecX& out) const {
+  for (int e = 0; e < num_elements(); ++e) {
+    // out_e += scale R K0 R^T v_e.
+    const Mat3& R = rotations_[e];
+    const auto& element = Traits::Elements(*mesh_)[e];
+    Nodes w;
+    for (int b = 0; b < kNodes; ++b) w[b] = R.transpose() * v.template segment<3>(3 * element[b]);
+    const Nodes K0w = Traits::MultiplyRestStiffness(data_, e, w);
+    for (int a = 0; a < kNodes; ++a)
+      out.template segment<3>(3 * element[a]) += scale * (R * K0w[a]);
+  }
+}
+
+template <typename Traits>
+double ElementModelImpl<Traits>::CalcEnergy(const VecX& x) const {
+  double energy = 0.0;
+  for (int e = 0; e < num_elements(); ++e) energy += CalcElementEnergy(e, x);
+  return energy;
+}
+
+template <typename Traits>
+double ElementModelImpl<Traits>::CalcElementEnergy(int e, const VecX& x) const {
+  const Nodes xe = GatherElement(x, e);
+  return Traits::CalcEnergy(data_, e, xe, Traits::CalcFrame(data_, e, xe));
+}
+
+template <typename Traits>
+double ElementModelImpl<Traits>::CalcElementForces(int e, const VecX& x,
+                                                   ElementVectors& forces) const {
+  const Nodes xe = GatherElement(x, e);
+  const typename Traits::Frame frame = Traits::CalcFrame(data_, e, xe);
+  const Nodes fe = Traits::CalcForces(data_, e, xe, frame);
+  for (int a = 0; a < kNodes; ++a) forces[a] = fe[a];
+  return Traits::CalcEnergy(data_, e, xe, frame);
+}
+
+template <typename Traits>
+void ElementModelImpl<Traits>::CalcElementStiffness(int e, const VecX& x, ElementMatrix& K) const {
+  const Nodes xe = GatherElement(x, e);
+  K = Traits::CalcFrozenStiffness(data_, e, Traits::CalcFrame(data_, e, xe).R);
+}
+
+template <typename Traits>
+Mat3 ElementModelImpl<Traits>::CalcElementDeformationGradient(int e, const VecX& x) const {
+  return Traits::CalcDeformationGradient(data_, e, GatherElement(x, e));
+}
+
+}  // namespace taut

@@ -1,0 +1,91 @@
+// The per-element kernels of co-rotated linear tets (corotated_tet_element.h) in the form
+// ElementModelImpl (element_model_impl.h) calls them.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "plugin/contact_surface.h"
+#include "plugin/corotated_tet_element.h"
+#include "plugin/material.h"
+#include "plugin/signed_svd.h"
+
+namespace taut {
+
+// Rest stiffness K0 of one tet as its 16 3x3 blocks, block (n,m) = CalcRestStiffnessBlock(n, m)
+// at index 4 n + m (1152 bytes) [N/m].
+using TetRestStiffness = std::array<Mat3, 16>;
+
+// The 16 blocks K0_nm of one tet, each exactly as CalcRestStiffnessBlock computes it.
+TetRestStiffness CalcTetRestStiffness(const TetRestElement& rest, const LameParameters& lame);
+
+struct TetElementTraits {
+  static constexpr int kNodes = 4;
+  using Mesh = TetMesh;
+  using Nodes = std::array<Vec3, 4>;
+
+  // Immutable rest data of a tet body with one material.
+  struct RestData {
+    TetRestData rest;                         // r_n and V of every tet
+    std::vector<TetRestStiffness> stiffness;  // K0 of every tet, from rest and lame
+    LameParameters lame;
+  };
+  // G = sum_n x_n r_n^T and its rotation R = polar(G).
+  struct Frame {
+    Mat3 G;
+    Mat3 R;
+  };
+
+  // Validates the material, then the mesh (throws InputError naming mesh.source), and computes
+  // r_n, V and K0 of every tet.
+  static RestData CalcRestData(const TetMesh& mesh, const Material& material);
+
+  static const std::vector<std::array<int, 4>>& Elements(const TetMesh& mesh) { return mesh.tets; }
+  static double Volume(const RestData& data, int e) { return data.rest.elements[e].volume; }
+
+  static Frame CalcFrame(const RestData& data, int e, const Nodes& x) {
+    const Mat3 G = CalcTetDeformationGradient(data.rest.elements[e], x);
+    return {G, CalcPolarRotation(G)};
+  }
+  // Psi = V [mu ||S - I||^2 + lambda/2 tr(S - I)^2], S = R^T G.
+  static double CalcEnergy(const RestData& data, int e, const Nodes& /*x*/, const Frame& frame) {
+    return CalcCorotatedTetEnergy(data.rest.elements[e], data.lame, frame.G, frame.R);
+  }
+  // f_n = -V P r_n, the exact -dPsi/dx_n.
+  static Nodes CalcForces(const RestData& data, int e, const Nodes& /*x*/, const Frame& frame) {
+    return CalcCorotatedTetForces(data.rest.elements[e], data.lame, frame.G, frame.R);
+  }
+
+  static const Mat3& RestStiffnessBlock(const RestData& data, int e, int a, int b) {
+    return data.stiffness[e][4 * a + b];
+  }
+  // (K0 w)_a = sum_b K0_ab w_b.
+  static Nodes MultiplyRestStiffness(const RestData& data, int e, const Nodes& w) {
+    const TetRestStiffness& K0 = data.stiffness[e];
+    Nodes K0w;
+    for (int a = 0; a < 4; ++a) {
+      Vec3 sum = Vec3::Zero();
+      for (int b = 0; b < 4; ++b) sum += K0[4 * a + b] * w[b];
+      K0w[a] = sum;
+    }
+    return K0w;
+  }
+  static Mat12 CalcFrozenStiffness(const RestData& data, int e, const Mat3& R) {
+    return CalcFrozenRotationTetStiffness(data.rest.elements[e], data.lame, R);
+  }
+  static Mat3 CalcDeformationGradient(const RestData& data, int e, const Nodes& x) {
+    return CalcTetDeformationGradient(data.rest.elements[e], x);
+  }
+
+  // Boundary vertices and faces.
+  static ContactSurface MakeContactSurface(const TetMesh& mesh) {
+    return MakeTetContactSurface(mesh);
+  }
+  // 4-node barycentric points (EmbedSurfaceInTets).
+  static ContactSurface MakeEmbeddedContactSurface(const TetMesh& mesh,
+                                                   const SurfaceMesh& surface) {
+    return MakeTetEmbeddedContactSurface(mesh, EmbedSurfaceInTets(mesh, surface));
+  }
+};
+
+}  // namespace taut
