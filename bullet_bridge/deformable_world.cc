@@ -210,6 +210,7 @@ void DeformableWorld::RemoveDeformableBody(DeformableBody* body) {
                          [body](const auto& entry) { return &entry->body() == body; });
   TAUT_DEMAND(it != bodies_.end(), "RemoveDeformableBody: body is not in this world");
   removeCollisionObject(&(*it)->collision_object());
+  forces_.Clear(forces_.h);  // they may name the body
   for (auto pair = pair_contacts_.begin(); pair != pair_contacts_.end();)
     pair = (pair->first.first == it->get() || pair->first.second == it->get())
                ? pair_contacts_.erase(pair)
@@ -298,7 +299,8 @@ void DeformableWorld::StepDeformables(double h, btContactSolverInfo& info, int& 
   stats_.ms_stage_bullet_solver = LapMs(lap);
   SolveIslands(h);  // 6. deformable islands
   stats_.ms_stage_solve_islands = LapMs(lap);
-  EndSteps(h);  // 7. integrate (Bullet integrates the rigid transforms next)
+  EndSteps(h);     // 7. integrate (Bullet integrates the rigid transforms next)
+  ReportForces();  // 8. forces out (timed with stage 7: a copy of the solved rows)
   stats_.ms_stage_end_steps = LapMs(lap);
   SumStageStats();  // 8. stats
 }
@@ -503,12 +505,46 @@ void DeformableWorld::EndSteps(double h) {
   for (RigidIslandBody* rigid : coupled_) rigid->EndStep();
 }
 
+void DeformableWorld::ReportForces() {
+  for (int i = 0; i < islands_.num_islands(); ++i) {
+    const Island& island = islands_.island(i);
+    if (island.sources.empty()) continue;  // not solved this substep
+    const IslandSolver& solver = bodies_[island.first_deformable]->solver;
+    AppendIslandForces(island.bodies, solver.last_rows(), solver.last_multipliers(),
+                       getCollisionObjectArray(), forces_);
+  }
+}
+
+std::vector<DeformableContactPoint> DeformableWorld::last_contacts(
+    const DeformableBody* body) const {
+  TAUT_DEMAND(HasBody(body), "last_contacts: deformable body is not in this world");
+  std::vector<DeformableContactPoint> contacts;
+  for (const DeformableContactPoint& contact : forces_.contacts)
+    if (contact.body == body) contacts.push_back(contact);
+  return contacts;
+}
+
+std::vector<LimitRowMultiplier> DeformableWorld::last_limit_multipliers(
+    const DeformableBody* body) const {
+  TAUT_DEMAND(HasBody(body), "last_limit_multipliers: deformable body is not in this world");
+  std::vector<LimitRowMultiplier> limits;
+  for (const LimitRowMultiplier& limit : forces_.limits)
+    if (limit.body == body) limits.push_back(limit);
+  return limits;
+}
+
+bool DeformableWorld::HasBody(const DeformableBody* body) const {
+  return std::any_of(bodies_.begin(), bodies_.end(),
+                     [body](const auto& entry) { return &entry->object->body() == body; });
+}
+
 void DeformableWorld::solveConstraints(btContactSolverInfo& info) {
+  const double h = static_cast<double>(info.m_timeStep);
+  forces_.Clear(h);
   if (bodies_.empty()) {
     btDiscreteDynamicsWorld::solveConstraints(info);
     return;
   }
-  const double h = static_cast<double>(info.m_timeStep);
   stats_ = StepStats();
   coupled_.clear();
   int begun = 0;
@@ -519,6 +555,7 @@ void DeformableWorld::solveConstraints(btContactSolverInfo& info) {
     // the world stays consistent at the last good state.
     for (int b = 0; b < begun; ++b) bodies_[b]->body().AbortStep();
     for (RigidIslandBody* rigid : coupled_) rigid->AbortStep();
+    forces_.Clear(h);
     throw;
   }
 }

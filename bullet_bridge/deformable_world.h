@@ -9,6 +9,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "bullet_bridge/contact_report.h"
 #include "bullet_bridge/deformable_collision_object.h"
 #include "bullet_bridge/island_builder.h"
 #include "bullet_bridge/joint_source.h"
@@ -113,6 +114,21 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   // converged, `substeps` their number (0 when the call only accumulated time; substeps without
   // deformable bodies count with zero figures). After a SimulationError: the substeps before it.
   const StepStats& last_call_stats() const { return call_stats_; }
+  // Forces out (bullet_bridge/contact_report.h): the contacts, rigid wrenches and limit
+  // multipliers the island solves of the LAST substep applied (a stepSimulation call of several
+  // substeps keeps only its last one's; refilled by every substep, empty after a SimulationError,
+  // after RemoveDeformableBody and in substeps without deformables). Impulses [N s], forces [N] =
+  // impulse / h, torques [N m]; contact impulses act on the deformable, wrenches on the rigid
+  // object (equal and opposite).
+  const SubstepForces& last_substep_forces() const { return forces_; }
+  // The last substep's contact points of `body` (impulses and force ON it, [N s] and [N]).
+  // Throws InputError when the body is not in this world.
+  std::vector<DeformableContactPoint> last_contacts(const DeformableBody* body) const;
+  // The last substep's total wrench [N], [N m] on each rigid object from every deformable.
+  const std::vector<RigidBodyWrench>& last_rigid_wrenches() const { return forces_.wrenches; }
+  // The last substep's limit rows of `body` with their multipliers [N m s]. Throws InputError
+  // when the body is not in this world.
+  std::vector<LimitRowMultiplier> last_limit_multipliers(const DeformableBody* body) const;
 
  protected:
   // One fixed substep; Bullet's sequence calls solveConstraints below between collision
@@ -178,6 +194,8 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   void SolveIslands(double h);
   // Stage 7: x = x0 + h v; coupled rigid bodies get their solved velocity back.
   void EndSteps(double h);
+  // Stage 8: forces out, each solved island's multipliers with their rows' metadata (forces_).
+  void ReportForces();
   // Stage 8: the substep's totals from the stage timers (the islands' SQP stats are in already).
   void SumStageStats();
   // Drives nodes attached to static/kinematic rigid bodies to their current anchors.
@@ -187,6 +205,8 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   RigidIslandBody* FindCoupledBody(const btCollisionObject& object, int& island);
   // The island body of a dynamic rigid body (made on first use).
   RigidIslandBody* FindRigidIslandBody(btRigidBody* rigid);
+  // True when `body` is one of this world's deformables.
+  bool HasBody(const DeformableBody* body) const;
   // The entry of a body; throws InputError when the body is not in this world.
   Entry& FindEntry(const DeformableBody* body);
   // Installs `source` on the body's entry, replacing any earlier source of the same type T.
@@ -206,6 +226,7 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   btEmptyAlgorithm::CreateFunc empty_algorithm_;
   StepStats stats_;
   StepStats call_stats_;  // totals of the last stepSimulation call
+  SubstepForces forces_;  // forces out of the last substep
 };
 
 }  // namespace taut

@@ -34,6 +34,10 @@ class SqpSolver {
              StepStats& stats);
   // Last step's multipliers by row key (shared with the primal path by IslandSolver).
   KeyedMultipliers& mutable_warm_starts() { return previous_; }
+  // The rows of the last Solve, collected at its final velocities, and their multipliers (one per
+  // row, the total multiplier lambda_k; contact rows: impulses [N s]). Read-only: forces out.
+  const IslandRows& rows() const { return rows_; }
+  const VecX& multipliers() const { return lambda_; }
 
  private:
   // Positions x_b of every body at velocities v (into x_).

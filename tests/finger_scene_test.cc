@@ -53,8 +53,8 @@ TEST(FingerSceneTest, AnisotropicFingerIsCompliantOnlyAlongTheNailNormal) {
   // as deep flat, the isotropic one equally (within 5 %).
   EXPECT_GT(r[0][0]->indentation, 2.0 * r[1][0]->indentation);
   EXPECT_NEAR(r[0][1]->indentation / r[1][1]->indentation, 1.0, 0.05);
-  // Isotropic presses reach the target force and no limit row is active, so the energy slope
-  // must equal the elastic force on the bone nodes (the force measure is right).
+  // Isotropic presses reach the target force and no limit row is active, so the table's contact
+  // forces must equal the elastic force on the bone nodes (the force measure is right).
   for (int axis = 0; axis < 3; ++axis) {
     const FingerPressResult& iso = *r[axis][1];
     EXPECT_EQ(iso.stop_reason, "force") << iso.name;

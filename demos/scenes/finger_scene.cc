@@ -32,17 +32,6 @@ Mat3 CalcPressRotation(FingerPressAxis axis) {
   }
   return R;
 }
-
-// dU/d(travel) at the last sample: the derivative of the parabola through the last three samples
-// (the secant with two), p'(x2) = s12 + (s12 - s01)(x2 - x1)/(x2 - x0), s_ij divided differences.
-double CalcEndSlope(const std::vector<double>& x, const std::vector<double>& y) {
-  const size_t n = x.size();
-  if (n < 2 || !(x[n - 1] > x[n - 2])) return 0.0;
-  const double s12 = (y[n - 1] - y[n - 2]) / (x[n - 1] - x[n - 2]);
-  if (n < 3 || !(x[n - 2] > x[n - 3])) return s12;
-  const double s01 = (y[n - 2] - y[n - 3]) / (x[n - 2] - x[n - 3]);
-  return s12 + (s12 - s01) * (x[n - 1] - x[n - 2]) / (x[n - 1] - x[n - 3]);
-}
 }  // namespace
 
 const char* GetFingerPressAxisName(FingerPressAxis axis) {
@@ -111,8 +100,8 @@ FingerScene::FingerScene(const std::vector<FingerPress>& presses,
   boundary_nodes_ = CalcBoundaryNodes(*mesh);
   AddTableAndBone(x_hi - x_lo);
   bone_centre_ = Vec3(0.5 * (x_lo + x_hi), 0.0, 0.0);
-  // The force estimate differentiates the energy: limits held to 1e-5 of their range (not the
-  // default 1e-3) and nearly stationary QPs keep the solver's tolerance out of dU.
+  // The reaction is read from the solved contact impulses: limits held to 1e-5 of their range
+  // (not the default 1e-3) and nearly stationary QPs keep the solver's tolerance out of it.
   world().mutable_solver_settings().violation_tolerance = settings.solver_tolerance;
   world().mutable_solver_settings().stationarity_tolerance = settings.solver_tolerance * 100.0;
   results_.resize(presses.size());
@@ -125,8 +114,9 @@ void FingerScene::AddTableAndBone(double bone_length) {
   btRigidBody::btRigidBodyConstructionInfo table(0.0, nullptr, holder_.shapes.back().get());
   table.m_startWorldTransform.setOrigin(btVector3(0.035, 0.0, -0.01));
   holder_.rigid_bodies.push_back(std::make_unique<btRigidBody>(table));
-  holder_.rigid_bodies.back()->setFriction(0.0);
-  world().addRigidBody(holder_.rigid_bodies.back().get());
+  table_ = holder_.rigid_bodies.back().get();
+  table_->setFriction(0.0);
+  world().addRigidBody(table_);
   // Kinematic bone: a thin capsule along the body x axis over the pinned nodes.
   holder_.shapes.push_back(
       std::make_unique<btCapsuleShapeX>(kBoneShapeRadius, std::max(bone_length, 1e-3)));
@@ -168,8 +158,6 @@ void FingerScene::BeginPress(int p) {
   time_ = held_ = travel_ = last_travel_ = contact_travel_ = reaction_ = 0.0;
   stopped_ = false;
   speed_factor_ = 1.0;
-  sample_travel_.clear();
-  sample_energy_.clear();
   sqp_sum_ = sweep_sum_ = ms_sum_ = 0.0;
   UpdateBoneTravel(0.0);
   world().AttachNodesToRigidBody(finger_, bone_nodes_, bone_);
@@ -218,13 +206,12 @@ void FingerScene::Measure(double dt) {
     EndPress();
 }
 
-double FingerScene::CalcPotentialEnergy() const {
-  const Vec3 g = ToEigen(world().getGravity());
-  double energy = finger_->CalcElasticEnergy();
-  for (int i = 0; i < finger_->num_nodes(); ++i)
-    if (finger_->node_kind(i) == NodeKind::kFree)
-      energy -= finger_->mass()[i] * g.dot(finger_->node_position(i));
-  return energy;
+double FingerScene::CalcTableReaction() const {
+  // R = sum over the finger's contacts with the table of f_c . z, f_c = impulse / h on the finger.
+  double reaction = 0.0;
+  for (const DeformableContactPoint& contact : world().last_substep_forces().contacts)
+    if (contact.body == finger_ && contact.partner_object == table_) reaction += contact.force.z();
+  return reaction;
 }
 
 double FingerScene::CalcFreeWeight() const {
@@ -297,10 +284,7 @@ void FingerScene::MeasureStep() {
     contact_travel_ = travel_ + gap;
   } else {
     result.touched = true;
-    // Quasi-static bone force F = dU/d(travel); the table also carries the free nodes' weight.
-    sample_travel_.push_back(travel_);
-    sample_energy_.push_back(CalcPotentialEnergy());
-    reaction_ = CalcEndSlope(sample_travel_, sample_energy_) + CalcFreeWeight();
+    reaction_ = CalcTableReaction();
     if (reaction_ >= settings_.target_force) {
       stopped_ = true;
       result.stop_reason = "force";

@@ -82,12 +82,11 @@ struct FingerPressResult {
 // target, until the table reaction reaches target_force ("force"), the tissue locks ("lock": a
 // limit or the contact is broken beyond the lock thresholds; the bone steps back to the last
 // travel that held them and the reaction is the one it locked at), or the travel cap ("travel");
-// then it holds still for hold_time. The table is frictionless, so the quasi-static bone force is
-// the slope of the potential energy, F = d(U_e + U_g)/d(travel) (envelope theorem: it includes
-// the active limits' forces), taken as the secant over the last advance; the table reaction is F
-// plus the free nodes' weight. Indentation = bone travel after the first contact: the table does
-// not move and nothing sinks into it, so the tissue between bone and table is compressed by that
-// much.
+// then it holds still for hold_time. The table reaction is read from the step's contact forces:
+// the z components of the table's forces on the finger, R = sum_c lambda_n,c n_c . z / h (the
+// solved impulses, DeformableWorld::last_contacts; the table is frictionless). Indentation = bone
+// travel after the first contact: the table does not move and nothing sinks into it, so the tissue
+// between bone and table is compressed by that much.
 class FingerScene : public Scene {
  public:
   explicit FingerScene(const std::vector<FingerPress>& presses,
@@ -132,8 +131,8 @@ class FingerScene : public Scene {
   void UpdateBoneTravel(double dt);
   // Records the step just taken into the current result and stop state.
   void MeasureStep();
-  // Potential energy U_e + U_g of the current finger [J].
-  double CalcPotentialEnergy() const;
+  // Table reaction of the last step: the z force of the table's contacts on the finger [N].
+  double CalcTableReaction() const;
   // Area of the boundary nodes within contact tolerance of the table [m^2].
   double CalcContactArea() const;
   // Weight of the free nodes [N].
@@ -150,6 +149,7 @@ class FingerScene : public Scene {
   std::vector<Triangle> boundary_faces_;
   std::vector<int> boundary_nodes_;
   Vec3 bone_centre_;  // bone capsule centre in the body frame [m]
+  btRigidBody* table_ = nullptr;
   btRigidBody* bone_ = nullptr;
   btDefaultMotionState* bone_state_ = nullptr;
   std::vector<FingerPressResult> results_;
@@ -166,9 +166,8 @@ class FingerScene : public Scene {
   double contact_travel_ = 0.0;       // travel at the first contact [m]
   bool stopped_ = false;
   double speed_factor_ = 1.0;  // fraction of bone_speed (slows down near the target)
-  double reaction_ = 0.0;      // current reaction estimate [N]
-  std::vector<double> sample_travel_, sample_energy_;  // recent (travel, U) after contact
-  mutable VecX scratch_;                               // elastic forces (3N)
+  double reaction_ = 0.0;      // table reaction of the last accepted step [N]
+  mutable VecX scratch_;       // elastic forces (3N)
   double sqp_sum_ = 0.0, sweep_sum_ = 0.0, ms_sum_ = 0.0;
   int key_press_ = -1;  // last press shown in a key frame
 };
