@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "bullet_bridge/body_pose.h"
+#include "bullet_bridge/collision_filter.h"
 #include "bullet_bridge/eigen_bullet.h"
 #include "plugin/tet_element_model.h"
 
@@ -349,6 +350,7 @@ void DeformableWorld::FindRigidPartners(Entry& entry, double reach) {
     btCollisionShape* shape = object->getCollisionShape();
     if (shape->getShapeType() == kDeformableShapeType) continue;
     if (!object->hasContactResponse() || object->getBroadphaseHandle() == nullptr) continue;
+    if (!ShouldCollide(entry.collision_object(), *object)) continue;  // groups and masks
     if (!Overlaps(lo, hi, *object->getBroadphaseHandle())) continue;
     PrepareNarrowphaseShape(*shape);
     // Static, kinematic and dynamic rigid objects; the island body of a dynamic one is set in
@@ -367,6 +369,8 @@ void DeformableWorld::FindDeformablePairs() {
       const Entry& second = *bodies_[e];
       if ((first.swept_lo.array() > second.swept_hi.array()).any() ||
           (second.swept_lo.array() > first.swept_hi.array()).any())
+        continue;
+      if (!ShouldCollide(first.object->collision_object(), second.object->collision_object()))
         continue;
       // The pair's source is kept across steps for its warm starts.
       auto& source = pair_contacts_[{&first, &second}];

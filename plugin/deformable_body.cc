@@ -57,6 +57,26 @@ void DeformableBody::CheckNode(int node, const char* what) const {
               " out of range [0, ", num_nodes(), ")");
 }
 
+Vec3 DeformableBody::node_position(int i) const {
+  CheckNode(i, "node_position:");
+  return x_.segment<3>(3 * i);
+}
+
+Vec3 DeformableBody::node_velocity(int i) const {
+  CheckNode(i, "node_velocity:");
+  return v_.segment<3>(3 * i);
+}
+
+double DeformableBody::node_mass(int i) const {
+  CheckNode(i, "node_mass:");
+  return mass_[i];
+}
+
+Vec3 DeformableBody::node_external_force(int i) const {
+  CheckNode(i, "node_external_force:");
+  return external_.segment<3>(3 * i);
+}
+
 void DeformableBody::FixNodes(const std::vector<int>& nodes) {
   for (int i : nodes) {
     CheckNode(i, "FixNodes:");

@@ -41,14 +41,24 @@ class DeformableBody {
   double element_rest_volume(int e) const { return model_->element_rest_volume(e); }
   int num_nodes() const { return model_->num_nodes(); }
   int num_elements() const { return model_->num_elements(); }
-  const VecX& x() const { return x_; }
-  const VecX& v() const { return v_; }
-  const VecX& x0() const { return x0_; }          // positions at the step start
-  const VecX& v_star() const { return v_star_; }  // unconstrained velocity of this step
-  const VecX& v0() const { return v0_; }          // velocity at the step start
+  const VecX& x() const { return x_; }            // node positions (3N, node-major xyz) [m]
+  const VecX& v() const { return v_; }            // node velocities (3N) [m/s]
+  const VecX& x0() const { return x0_; }          // positions at the step start [m]
+  const VecX& v_star() const { return v_star_; }  // unconstrained velocity of this step [m/s]
+  const VecX& v0() const { return v0_; }          // velocity at the step start [m/s]
   const VecX& mass() const { return mass_; }      // lumped mass per node [kg]
   NodeKind node_kind(int i) const { return kinds_[i]; }
-  Vec3 node_position(int i) const { return x_.segment<3>(3 * i); }
+  // Node i's current position [m], world frame (x_i of x). Throws InputError naming the body and
+  // the index for i outside [0, num_nodes()); nothing changes.
+  Vec3 node_position(int i) const;
+  // Node i's current velocity [m/s] (v_i of v: after a step the solved, constrained velocity).
+  // Throws like node_position.
+  Vec3 node_velocity(int i) const;
+  // Node i's lumped mass m_i [kg] (mass()[i], > 0). Throws like node_position.
+  double node_mass(int i) const;
+  // The external force queued on node i for the next step by AddNodeForce [N] (zero after that
+  // step has begun). Throws like node_position.
+  Vec3 node_external_force(int i) const;
   const ImplicitSystem& system() const { return system_; }
   // The step's system, for the primal constraint solver's Newton matrix (between BeginStep and
   // EndStep).
@@ -68,7 +78,14 @@ class DeformableBody {
   void SetKinematicTarget(int node, const Vec3& target);
   // Frees a fixed or kinematic node.
   void ReleaseNode(int node);
-  // Adds an external force on a node for the next step only [N].
+  // Adds an external force f [N] (world frame) on a node for the next step only: BeginStep adds
+  // it to f(x0) in b = M v0 + h f(x0), so a free body without other forces gains momentum h f
+  // (a node gets h f_i / m_i when every node is pushed with the same acceleration f_i / m_i), and
+  // then clears it. In a DeformableWorld that step is the next fixed substep: with several
+  // substeps per stepSimulation call only the first feels it (call again before each call, and
+  // divide by the number of substeps for an impulse over the frame). Calls add up. No effect on
+  // fixed or kinematic nodes. Throws InputError naming the body and the node for an index
+  // outside [0, num_nodes()) or a non-finite force; nothing is queued then.
   void AddNodeForce(int node, const Vec3& force);
 
   // Stage 2 of the world step: assemble, factor and solve the unconstrained velocity v*.
