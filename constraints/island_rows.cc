@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "constraints/row_key_layouts.h"
+
 namespace taut {
 
 double IslandRows::Collect(double h, const std::vector<IslandBody*>& bodies,
@@ -31,11 +33,47 @@ void IslandRows::WarmStart(const KeyedMultipliers& from, VecX& lambda) const {
   OverwriteByKey(from, lambda);
 }
 
+namespace {
+// Same element and bound, and the same limit axis j, except that the rows with one row per
+// principal stretch (ellipsoid, linear interpolation: j = m) match each other whatever m is.
+// Rows of different j (hyperbolic, orthogonal) are different constraints.
+bool IsStrainRowSibling(std::uint64_t a, std::uint64_t b) {
+  if ((a & ~kStrainLimitDirectionBits) != (b & ~kStrainLimitDirectionBits)) return false;
+  const auto fields_a = UnpackRowKeyPayload(kStrainLimitRowKey, RowKeyPayload(a));
+  const auto fields_b = UnpackRowKeyPayload(kStrainLimitRowKey, RowKeyPayload(b));
+  const bool per_stretch_a = fields_a[1] == fields_a[2], per_stretch_b = fields_b[1] == fields_b[2];
+  return per_stretch_a && per_stretch_b
+             ? true
+             : !per_stretch_a && !per_stretch_b && fields_a[1] == fields_b[1];
+}
+}  // namespace
+
 void IslandRows::OverwriteByKey(const KeyedMultipliers& from, VecX& values) const {
+  claimed_.assign(from.size(), 0);
+  unmatched_.clear();
   for (size_t c = 0; c < rows_.size(); ++c) {
     const auto it =
         std::lower_bound(from.begin(), from.end(), std::make_pair(rows_[c].key, -HUGE_VAL));
-    if (it != from.end() && it->first == rows_[c].key) values[c] = it->second;
+    if (it != from.end() && it->first == rows_[c].key) {
+      values[c] = it->second;
+      claimed_[it - from.begin()] = 1;
+    } else if (rows_[c].type == RowType::kStrainLimit) {
+      unmatched_.push_back(static_cast<int>(c));
+    }
+  }
+  // R3: the keys of one element are adjacent in `from` (the element field lies above the
+  // direction and bound bits); take the first unclaimed one with the same bound.
+  for (int c : unmatched_) {
+    const std::uint64_t key = rows_[c].key;
+    const std::uint64_t element = key >> kStrainLimitElementShift;
+    const std::uint64_t first = element << kStrainLimitElementShift;
+    for (auto it = std::lower_bound(from.begin(), from.end(), std::make_pair(first, -HUGE_VAL));
+         it != from.end() && (it->first >> kStrainLimitElementShift) == element; ++it) {
+      if (claimed_[it - from.begin()] || !IsStrainRowSibling(key, it->first)) continue;
+      values[c] = it->second;
+      claimed_[it - from.begin()] = 1;
+      break;
+    }
   }
 }
 

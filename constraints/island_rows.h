@@ -32,7 +32,9 @@ class IslandRows {
   void WarmStart(const KeyedMultipliers& from, VecX& lambda) const;
   // to <- the nonzero multipliers of the rows by key, sorted.
   void Store(const VecX& lambda, KeyedMultipliers& to) const;
-  // values[c] <- the value of `from` with row c's key where `from` has one; other rows keep theirs.
+  // values[c] <- the value of `from` with row c's key where `from` has one; a strain row without
+  // one takes an unclaimed value of a sibling key (same element and bound, another principal
+  // direction: kStrainLimitDirectionBits); other rows keep theirs.
   void OverwriteByKey(const KeyedMultipliers& from, VecX& values) const;
   // Row counts by type into stats (rows_strain, ...).
   void CountTypes(StepStats& stats) const;
@@ -53,6 +55,8 @@ class IslandRows {
   std::vector<ConstraintRow> rows_;
   std::vector<std::vector<int>> body_rows_;
   std::vector<VecX> x_;
+  mutable std::vector<char> claimed_;   // OverwriteByKey: entries of `from` taken
+  mutable std::vector<int> unmatched_;  // OverwriteByKey: strain rows without their key
 };
 
 }  // namespace taut

@@ -34,7 +34,7 @@ void IslandSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
   if (primal_steps_left_ > 0) --primal_steps_left_;
   if (kind == IslandSolverKind::kPrimal) {
     primal_.Solve(h, bodies, sources, settings, warm_, stats);
-    CollectSolvedRows(h, bodies, sources);
+    solved_primal_ = true;
   } else {
     std::swap(dual_.mutable_warm_starts(), warm_);
     dual_.Solve(h, bodies, sources, settings, stats);
@@ -49,15 +49,6 @@ void IslandSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
       primal_steps_left_ = kPrimalStepsAfterDualFailure;
   }
   last_rows_ = stats.rows_total();
-}
-
-void IslandSolver::CollectSolvedRows(double h, const std::vector<IslandBody*>& bodies,
-                                     const std::vector<ConstraintSource*>& sources) {
-  solved_v_.resize(bodies.size());
-  for (size_t b = 0; b < bodies.size(); ++b) solved_v_[b] = bodies[b]->v();
-  solved_rows_.Collect(h, bodies, sources, solved_v_, 1.0);
-  solved_rows_.WarmStart(warm_, solved_lambda_);
-  solved_primal_ = true;
 }
 
 }  // namespace taut

@@ -30,28 +30,19 @@ class IslandSolver {
   static IslandSolverKind ChooseAuto(int rows, int free_dofs, int primal_steps_left = 0);
 
   // The rows of the last Solve at its final velocities and their multipliers, one per row
-  // (contact rows: impulses [N s]; limit rows [N m s]): the dual path's own, or, after the primal
-  // path, the rows collected again at the final velocities with the primal multipliers by key.
-  // Reading them changes nothing; valid until the next Solve.
-  const IslandRows& last_rows() const { return solved_primal_ ? solved_rows_ : dual_.rows(); }
+  // (contact rows: impulses [N s]; limit rows [N m s]), from the path that ran. Reading them
+  // changes nothing; valid until the next Solve.
+  const IslandRows& last_rows() const { return solved_primal_ ? primal_.rows() : dual_.rows(); }
   const VecX& last_multipliers() const {
-    return solved_primal_ ? solved_lambda_ : dual_.multipliers();
+    return solved_primal_ ? primal_.multipliers() : dual_.multipliers();
   }
 
  private:
-  // Primal path: rows at the bodies' final velocities into solved_rows_, warm_ by key into
-  // solved_lambda_ (the primal solver keeps its rows to itself).
-  void CollectSolvedRows(double h, const std::vector<IslandBody*>& bodies,
-                         const std::vector<ConstraintSource*>& sources);
-
   SqpSolver dual_;
   PrimalSolver primal_;
-  KeyedMultipliers warm_;      // last step's multipliers by key, whichever path ran
-  int last_rows_ = 0;          // rows at the end of the last step
-  int primal_steps_left_ = 0;  // > 0: the dual path failed recently, stay primal
-  IslandRows solved_rows_;     // primal path: the rows at the final velocities
-  VecX solved_lambda_;         // their multipliers
-  std::vector<VecX> solved_v_;
+  KeyedMultipliers warm_;       // last step's multipliers by key, whichever path ran
+  int last_rows_ = 0;           // rows at the end of the last step
+  int primal_steps_left_ = 0;   // > 0: the dual path failed recently, stay primal
   bool solved_primal_ = false;  // the last Solve took the primal path
 };
 

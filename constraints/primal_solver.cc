@@ -92,6 +92,34 @@ void PrimalSolver::CalcPenalties(const std::vector<IslandBody*>& bodies,
   if (rho_kept_) rows_.OverwriteByKey(kept_rho_, rho_);
 }
 
+void PrimalSolver::GrowStalledPenalties(const PrimalSettings& settings, double tolerance) {
+  // A limit row still violated by more than the tolerance whose violation fell by less than half
+  // over the last multiplier iteration has its rho multiplied by penalty_growth, up to
+  // max_penalty_growth times its Delassus value (docs/math.md §5.8, penalty growth). rho_ holds
+  // the kept, already grown, penalties of the last multiplier iteration.
+  const int m = rows_.size();
+  last_.setConstant(m, -1.0);
+  growth_.setOnes(m);
+  rows_.OverwriteByKey(last_violation_, last_);
+  rows_.OverwriteByKey(kept_growth_, growth_);
+  last_violation_.clear();
+  kept_growth_.clear();
+  for (int c = 0; c < m; ++c) {
+    if (!IsLimitRow(rows_[c])) continue;
+    const double violation = std::max(0.0, -rows_[c].C);
+    if (violation > tolerance && last_[c] >= 0.0 && violation > 0.5 * last_[c]) {
+      const double next =
+          std::min(growth_[c] * settings.penalty_growth, settings.max_penalty_growth);
+      rho_[c] *= next / growth_[c];
+      growth_[c] = next;
+    }
+    last_violation_.emplace_back(rows_[c].key, violation);
+    if (growth_[c] != 1.0) kept_growth_.emplace_back(rows_[c].key, growth_[c]);
+  }
+  std::sort(last_violation_.begin(), last_violation_.end());
+  std::sort(kept_growth_.begin(), kept_growth_.end());
+}
+
 void PrimalSolver::KeepPenalties() {
   // Limit rows only: kept contact penalties left a rigid stack's friction unconverged (95 of 480
   // steps against 4; docs/math.md §5.8).
@@ -589,6 +617,8 @@ void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
   }
   iterate_ = settings.warm_start ? warm : KeyedMultipliers();
   rho_kept_ = false;
+  last_violation_.clear();
+  kept_growth_.clear();
   refactor_next_ = false;  // a factor kept from the previous step may precondition this one
   const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
   CollectRowsAt(h, bodies, sources, start, settings, stats);
@@ -610,6 +640,7 @@ void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     }
     // Minimize Phi for this lambda_bar and rho, then the multiplier update
     // lambda_bar <- Proj(y(v)).
+    if (primal.penalty_growth > 1.0) GrowStalledPenalties(primal, settings.violation_tolerance);
     KeepPenalties();
     for (int it = 0; it < primal.max_newton_iterations; ++it)
       if (!TakeNewtonStep(h, bodies, sources, settings, stats)) break;

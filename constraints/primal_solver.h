@@ -40,6 +40,10 @@ class PrimalSolver {
   void Solve(double h, const std::vector<IslandBody*>& bodies,
              const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
              KeyedMultipliers& warm, StepStats& stats);
+  // The rows of the last Solve at its final velocities and their multipliers lambda_bar (one per
+  // row; contact rows: impulses [N s]). Read-only: forces out.
+  const IslandRows& rows() const { return rows_; }
+  const VecX& multipliers() const { return lambda_bar_; }
 
  private:
   // Stage: rows, C and J at v (into rows_), lambda_bar by key, penalties, linearization.
@@ -59,6 +63,9 @@ class PrimalSolver {
   // multiplier iteration, so grad Phi is the gradient of the Phi the line search measures
   // (docs/math.md §5.8, penalties).
   void KeepPenalties();
+  // Stage: rho of limit rows whose violation stalls over a multiplier iteration grows
+  // (PrimalSettings::penalty_growth), applied to the kept penalties before KeepPenalties.
+  void GrowStalledPenalties(const PrimalSettings& settings, double tolerance);
   // g0_c with g_c(v + dv) = g0_c + J_c (v + dv) at the collected rows, and which rows H can hold
   // on the bodies' patterns.
   void LinearizeRows(double h, const std::vector<IslandBody*>& bodies);
@@ -104,6 +111,9 @@ class PrimalSolver {
   VecX rho_, g0_, jv_, s_;     // penalties, g_c(v) = g0 + J v, J v, J d
   KeyedMultipliers kept_rho_;  // limit rows' rho of this multiplier iteration by key
   bool rho_kept_ = false;
+  KeyedMultipliers last_violation_;      // limit rows' max(0, -C) at the last multiplier iteration
+  KeyedMultipliers kept_growth_;         // limit rows' rho growth (> 1) of this step by key
+  VecX last_, growth_;                   // the two by row (scratch)
   VecX d_unit_;                          // D_c of scalar rows (0 or 1)
   std::vector<Eigen::Matrix2d> d_disk_;  // D of a friction pair, on its first tangent row
   std::vector<char> in_pattern_;         // row's same-body blocks fit the patterns

@@ -18,6 +18,14 @@ inline constexpr RowKeyLayout<4> kStrainLimitRowKey{
         {"bound", 1},           // StrainBound: 0 min, 1 max
     }}};
 
+// The payload bits of kStrainLimitRowKey that name a row's principal direction (axis and principal
+// axis, above the bound bit). Where two stretches are nearly equal the match of their directions
+// to material axes can flip between iterates (docs/math.md §2.6, R3) while the row, its element
+// and its bound stay: warm starts fall back to such a sibling key (IslandRows::OverwriteByKey).
+inline constexpr std::uint64_t kStrainLimitDirectionBits = ((std::uint64_t{1} << 4) - 1) << 1;
+// The payload bits of kStrainLimitRowKey below the element field.
+inline constexpr std::uint64_t kStrainLimitElementShift = 5;
+
 // EnergyLimitConstraint: a row per element (the element in the low bits: key = source | element).
 inline constexpr RowKeyLayout<1> kEnergyLimitRowKey{
     "energy limits",
@@ -73,6 +81,11 @@ inline constexpr RowKeyLayout<2> kNodeAttachmentRowKey{
     }}};
 
 static_assert(kStrainLimitRowKey.bits() <= kRowKeyPayloadBits, "strain-limit key too wide");
+static_assert(kStrainLimitRowKey.fields[1].bits + kStrainLimitRowKey.fields[2].bits +
+                          kStrainLimitRowKey.fields[3].bits ==
+                      kStrainLimitElementShift &&
+                  kStrainLimitRowKey.fields[3].bits == 1,
+              "kStrainLimitDirectionBits must follow kStrainLimitRowKey's layout");
 static_assert(kEnergyLimitRowKey.bits() <= kRowKeyPayloadBits, "energy-limit key too wide");
 static_assert(kDeformableContactRowKey.bits() <= kRowKeyPayloadBits, "contact key too wide");
 static_assert(kRigidContactRowKey.bits() <= kRowKeyPayloadBits, "rigid-contact key too wide");

@@ -21,6 +21,10 @@ struct PrimalSettings {
   int max_iterations = 40;         // SQP (multiplier) iterations per step (cap)
   int max_newton_iterations = 12;  // Newton iterations per linearized problem (cap)
   double penalty_scale = 1e3;      // rho_c w_c: penalty over the row's diagonal compliance
+  // A limit row still violated whose violation fell by less than half over a multiplier
+  // iteration gets penalty_growth times its rho, up to max_penalty_growth times (1 = off).
+  double penalty_growth = 3.0;
+  double max_penalty_growth = 10.0;
   double newton_tolerance = 1e-9;  // stop when the Newton decrement < this * ||v - v*||_A^2
   int max_pcg_iterations = 200;    // coupled islands: PCG on the Newton step
   double pcg_tolerance = 1e-10;    // relative residual of that PCG

@@ -107,7 +107,7 @@ stage_fuzz() {
 # of a 1,397 s stage (CI's budget is 30 minutes for everything); their code paths (contact, rigid
 # coupling, the primal solver) are covered under the sanitizers by the shorter tests of the same
 # suites.
-asan_long_tests='SwingingAnisotropicBeamIsCertified|HeavyBoxRestsOnASoftLimitedBlock|RigidStackOnASoftBodyHolds|SoftCubeDroppedOnAnother'
+asan_long_tests='SwingingAnisotropicBeamIsCertified|StalledLimitRowsGetLargerPenalties|HeavyBoxRestsOnASoftLimitedBlock|RigidStackOnASoftBodyHolds|SoftCubeDroppedOnAnother'
 asan_long_tests+='|RigidBoxOnASoftBlockComesToRest|RestitutionOfRigidContactsInsideTheIsland'
 asan_long_tests+='|PinnedBarRestingOnASoftBlock'
 
