@@ -10,51 +10,17 @@
 
 #include "bullet_bridge/deformable_world.h"
 #include "plugin/box_tet_mesher.h"
+#include "tests/block_world.h"
 
 namespace taut {
 namespace {
 
 // A world holding one small tet block "block" (bottom at z = `bottom`, cells x cells x 1 cubes)
 // and static boxes on demand.
-struct FilterScene {
-  btDefaultCollisionConfiguration configuration;
-  btCollisionDispatcher dispatcher{&configuration};
-  btDbvtBroadphase broadphase;
-  btSequentialImpulseConstraintSolver solver;
-  DeformableWorld world{&dispatcher, &broadphase, &solver, &configuration};
-  DeformableBody* block = nullptr;
-  std::vector<std::unique_ptr<btCollisionShape>> shapes;
-  std::vector<std::unique_ptr<btCollisionObject>> objects;
-
-  explicit FilterScene(double bottom = 0.1, int cells = 2) {
-    world.setGravity(btVector3(0, 0, -9.81));
-    DeformableBodySettings settings;
-    settings.name = "block";
-    settings.material = {1e5, 0.3, 1000};
-    block = world.AddTetBody(
-        MakeBoxTetMesh(Vec3(0.2, 0.2, 0.1), cells, cells, 1, Vec3(0, 0, bottom)), settings);
-  }
-  ~FilterScene() {
-    for (auto& object : objects) world.removeCollisionObject(object.get());
-  }
-  // A static object with `shape` at `position`, in `group` with `mask`.
-  btCollisionObject* Add(btCollisionShape* shape, const btVector3& position,
-                         int group = btBroadphaseProxy::DefaultFilter,
-                         int mask = btBroadphaseProxy::AllFilter) {
-    shapes.emplace_back(shape);
-    objects.push_back(std::make_unique<btCollisionObject>());
-    objects.back()->setCollisionShape(shape);
-    objects.back()->setWorldTransform(btTransform(btQuaternion::getIdentity(), position));
-    world.addCollisionObject(objects.back().get(), group, mask);
-    return objects.back().get();
-  }
-  // The block's collision object.
-  btCollisionObject& BlockObject() {
-    const btCollisionObjectArray& all = world.getCollisionObjectArray();
-    for (int i = 0; i < all.size(); ++i)
-      if (all[i]->getUserPointer() == block) return *all[i];
-    throw std::logic_error("block not in the world");
-  }
+struct FilterScene : BlockWorld {
+  explicit FilterScene(double bottom = 0.1, int cells = 2)
+      : BlockWorld(MakeBoxTetMesh(Vec3(0.2, 0.2, 0.1), cells, cells, 1, Vec3(0, 0, bottom)),
+                   btVector3(0, 0, -9.81)) {}
   // Lowest node height [m].
   double Bottom() const {
     double z = 1e300;
@@ -67,10 +33,10 @@ TEST(CollisionFilterTest, ShouldCollideFollowsBulletGroupsMasksAndIgnoreLists) {
   FilterScene scene;
   const btCollisionObject& block = scene.BlockObject();  // DefaultFilter (1), AllFilter
   btSphereShape* shape = new btSphereShape(0.1);
-  btCollisionObject* everyone = scene.Add(shape, btVector3(3, 0, 0));
-  btCollisionObject* picky = scene.Add(new btSphereShape(0.1), btVector3(4, 0, 0), 2, 2);
+  btCollisionObject* everyone = scene.AddObject(shape, btVector3(3, 0, 0));
+  btCollisionObject* picky = scene.AddObject(new btSphereShape(0.1), btVector3(4, 0, 0), 2, 2);
   btCollisionObject* other_group =
-      scene.Add(new btSphereShape(0.1), btVector3(5, 0, 0), 2, btBroadphaseProxy::AllFilter);
+      scene.AddObject(new btSphereShape(0.1), btVector3(5, 0, 0), 2, btBroadphaseProxy::AllFilter);
   EXPECT_TRUE(ShouldCollide(block, *everyone));
   EXPECT_FALSE(ShouldCollide(block, *picky));  // picky's mask 2 leaves out the block's group 1
   EXPECT_TRUE(ShouldCollide(block, *other_group));
@@ -105,8 +71,8 @@ TEST(CollisionFilterTest, WorldSkipsRigidPartnersTheFilterExcludes) {
     FilterScene scene(0.002, 1);
     const int mask = excluded ? btBroadphaseProxy::AllFilter & ~btBroadphaseProxy::DefaultFilter
                               : btBroadphaseProxy::AllFilter;
-    scene.Add(new btBoxShape(btVector3(1, 1, 0.05)), btVector3(0.1, 0.1, -0.05),
-              btBroadphaseProxy::StaticFilter, mask);  // top face at z = 0
+    scene.AddObject(new btBoxShape(btVector3(1, 1, 0.05)), btVector3(0.1, 0.1, -0.05),
+                    btBroadphaseProxy::StaticFilter, mask);  // top face at z = 0
     VecX v = VecX::Zero(3 * scene.block->num_nodes());
     for (int i = 0; i < scene.block->num_nodes(); ++i) v[3 * i + 2] = -1.0;
     scene.block->set_v(v);

@@ -11,6 +11,7 @@
 #include "plugin/box_tet_mesher.h"
 #include "plugin/hex_lattice.h"
 #include "plugin/surface_hit_element.h"
+#include "tests/block_world.h"
 
 namespace taut {
 namespace {
@@ -20,44 +21,8 @@ constexpr double kTop = 0.3, kBottom = 0.1;
 const Vec3 kSize(0.4, 0.3, 0.2), kCorner(0, 0, 0.1);
 
 // A world without gravity holding one tet block "block" at rest, and rigid objects on demand.
-struct BlockScene {
-  btDefaultCollisionConfiguration configuration;
-  btCollisionDispatcher dispatcher{&configuration};
-  btDbvtBroadphase broadphase;
-  btSequentialImpulseConstraintSolver solver;
-  DeformableWorld world{&dispatcher, &broadphase, &solver, &configuration};
-  DeformableBody* block = nullptr;
-  std::vector<std::unique_ptr<btCollisionShape>> shapes;
-  std::vector<std::unique_ptr<btCollisionObject>> objects;
-
-  BlockScene() {
-    world.setGravity(btVector3(0, 0, 0));
-    DeformableBodySettings settings;
-    settings.name = "block";
-    settings.material = {1e5, 0.3, 1000};
-    block = world.AddTetBody(MakeBoxTetMesh(kSize, 2, 2, 1, kCorner), settings);
-  }
-  ~BlockScene() {
-    for (auto& object : objects) world.removeCollisionObject(object.get());
-  }
-  // A static collision object (not a rigid body) with `shape` at `position`, in group/mask.
-  btCollisionObject* AddObject(btCollisionShape* shape, const btVector3& position,
-                               int group = btBroadphaseProxy::DefaultFilter,
-                               int mask = btBroadphaseProxy::AllFilter) {
-    shapes.emplace_back(shape);
-    objects.push_back(std::make_unique<btCollisionObject>());
-    objects.back()->setCollisionShape(shape);
-    objects.back()->setWorldTransform(btTransform(btQuaternion::getIdentity(), position));
-    world.addCollisionObject(objects.back().get(), group, mask);
-    return objects.back().get();
-  }
-  // The block's collision object.
-  btCollisionObject& BlockObject() {
-    const btCollisionObjectArray& all = world.getCollisionObjectArray();
-    for (int i = 0; i < all.size(); ++i)
-      if (all[i]->getUserPointer() == block) return *all[i];
-    throw std::logic_error("block not in the world");
-  }
+struct BlockScene : BlockWorld {
+  BlockScene() : BlockWorld(MakeBoxTetMesh(kSize, 2, 2, 1, kCorner), btVector3(0, 0, 0)) {}
 };
 
 // A vertical ray at (x, y) from z = 1 down to z = -1; hits at z have fraction (1 - z) / 2.
