@@ -519,22 +519,27 @@ void DeformableWorld::ReportForces() {
   }
 }
 
+namespace {
+// The entries of `all` (contacts or limit rows of the last substep) that belong to `body`.
+template <typename Entry>
+std::vector<Entry> SelectBodyEntries(const std::vector<Entry>& all, const DeformableBody* body) {
+  std::vector<Entry> selected;
+  for (const Entry& entry : all)
+    if (entry.body == body) selected.push_back(entry);
+  return selected;
+}
+}  // namespace
+
 std::vector<DeformableContactPoint> DeformableWorld::last_contacts(
     const DeformableBody* body) const {
   TAUT_DEMAND(HasBody(body), "last_contacts: deformable body is not in this world");
-  std::vector<DeformableContactPoint> contacts;
-  for (const DeformableContactPoint& contact : forces_.contacts)
-    if (contact.body == body) contacts.push_back(contact);
-  return contacts;
+  return SelectBodyEntries(forces_.contacts, body);
 }
 
 std::vector<LimitRowMultiplier> DeformableWorld::last_limit_multipliers(
     const DeformableBody* body) const {
   TAUT_DEMAND(HasBody(body), "last_limit_multipliers: deformable body is not in this world");
-  std::vector<LimitRowMultiplier> limits;
-  for (const LimitRowMultiplier& limit : forces_.limits)
-    if (limit.body == body) limits.push_back(limit);
-  return limits;
+  return SelectBodyEntries(forces_.limits, body);
 }
 
 bool DeformableWorld::HasBody(const DeformableBody* body) const {
