@@ -36,6 +36,9 @@ struct ConstraintRow {
   double C = 0.0;         // value at the iterate, >= 0 feasible (bilateral: = 0 feasible)
   int body = -1;          // index of side A's body in the island
   int num_nodes = 0;
+  // Element of `body` whose nodes are `nodes` (strain and energy rows; -1 for other rows): its
+  // node blocks lie in the body's Newton pattern, addressed through the element's value map.
+  int element = -1;
   RowType type = RowType::kStrainLimit;
   bool bilateral = false;  // C = 0 with lo <= lambda <= hi (joints, attachments)
   double lo = -std::numeric_limits<double>::infinity();  // bilateral rows: multiplier bounds
@@ -81,6 +84,16 @@ class CurvatureSink {
   virtual ~CurvatureSink() = default;
   // metric(body; node_a, node_b) += block (3x3, dC^2/dx_a dx_b units times the weight).
   virtual void AddBlock(int body, int node_a, int node_b, const Mat3& block) = 0;
+  // metric(body; nodes of `element`) += block (3k x 3k over the element's k nodes, node-major).
+  // By default one AddBlock per node pair.
+  virtual void AddElementBlock(int body, int element, const int* nodes,
+                               const Eigen::Ref<const MatX>& block) {
+    (void)element;
+    const int k = static_cast<int>(block.rows() / 3);
+    for (int a = 0; a < k; ++a)
+      for (int b = 0; b < k; ++b)
+        AddBlock(body, nodes[a], nodes[b], block.block<3, 3>(3 * a, 3 * b));
+  }
 };
 
 // Anything that emits rows for an island (limits, contacts, joints), evaluated at an iterate.

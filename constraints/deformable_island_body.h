@@ -33,6 +33,10 @@ class DeformableIslandBody final : public IslandBody {
   void AddNewtonBlock(int i, int j, const Mat3& block) override {
     body_->mutable_system().AddNewtonBlock(i, j, block);
   }
+  void AddNewtonElementBlock(int e, const int* /*nodes*/,
+                             const Eigen::Ref<const MatX>& block) override {
+    body_->mutable_system().AddNewtonElementBlock(e, block);
+  }
   void FactorNewtonMatrix() override { body_->mutable_system().FactorNewtonMatrix(body_->name()); }
   void SolveNewton(Eigen::Ref<VecX> rhs) const override { body_->system().SolveNewton(rhs); }
   double CalcNewtonRefactorCost() const override {

@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "constraints/curvature_blocks.h"
-
 namespace taut {
 
 namespace {
@@ -53,6 +51,7 @@ int EnergyLimitConstraint::AppendRows(const VecX& x, int body_index,
     ConstraintRow& row = rows.emplace_back();
     row.key = key_.Pack(e);  // one bound per element
     row.body = body_index;
+    row.element = e;
     row.type = RowType::kEnergyLimit;
     FillRow(x, e, row);
   }
@@ -69,8 +68,8 @@ void EnergyLimitConstraint::AddIslandCurvature(const IslandIterate& iterate,
     // -d^2 C/dx^2 = K_e(R)/U_max with R frozen at the iterate.
     ElementMatrix H;
     body_.model().CalcElementStiffness(e, iterate.x(row.body), H);
-    H /= u_max_[e];
-    AddElementCurvatureBlocks(H, weights[c], row.body, body_.model().element_nodes(e), sink);
+    H *= weights[c] / u_max_[e];
+    sink.AddElementBlock(row.body, e, body_.model().element_nodes(e), H);
   }
 }
 

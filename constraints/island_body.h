@@ -49,6 +49,15 @@ class IslandBody {
   virtual bool IsInNewtonPattern(int i, int j) const = 0;
   // H(i, j) += block (blocks that do not move freely are dropped). Requires IsInNewtonPattern.
   virtual void AddNewtonBlock(int i, int j, const Mat3& block) = 0;
+  // H(nodes of element e) += block (3k x 3k, the element's k nodes `nodes`, node-major): the
+  // blocks of a row or curvature local to one element. By default one AddNewtonBlock per pair.
+  virtual void AddNewtonElementBlock(int e, const int* nodes, const Eigen::Ref<const MatX>& block) {
+    (void)e;
+    const int k = static_cast<int>(block.rows() / 3);
+    for (int a = 0; a < k; ++a)
+      for (int b = 0; b < k; ++b)
+        AddNewtonBlock(nodes[a], nodes[b], block.block<3, 3>(3 * a, 3 * b));
+  }
   // Factors H; throws SimulationError when it is not positive definite.
   virtual void FactorNewtonMatrix() = 0;
   // rhs <- H^-1 rhs (zero on blocks that do not move freely).

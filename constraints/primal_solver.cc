@@ -54,20 +54,6 @@ double LowerBound(const ConstraintRow& row) { return row.bilateral ? row.lo : 0.
 double UpperBound(const ConstraintRow& row) {
   return row.bilateral ? row.hi : std::numeric_limits<double>::infinity();
 }
-
-// Collects the sources' curvature blocks into a list (each source sums an element's rows and
-// emits one block per node pair of the element).
-template <typename Block>
-class CurvatureList final : public CurvatureSink {
- public:
-  explicit CurvatureList(std::vector<Block>& blocks) : blocks_(blocks) {}
-  void AddBlock(int body, int a, int b, const Mat3& block) override {
-    blocks_.push_back({body, a, b, block});
-  }
-
- private:
-  std::vector<Block>& blocks_;
-};
 }  // namespace
 
 void PrimalSolver::CalcPenalties(const std::vector<IslandBody*>& bodies,
@@ -145,7 +131,9 @@ void PrimalSolver::LinearizeRows(double h, const std::vector<IslandBody*>& bodie
                             previous->body2 == row.body2 && previous->num_nodes == row.num_nodes &&
                             previous->num_nodes2 == row.num_nodes2 &&
                             previous->nodes == row.nodes && previous->nodes2 == row.nodes2;
-    if (same_nodes) {
+    if (row.element >= 0 && row.body2 < 0) {
+      // An element's rows: its node blocks are in the pattern by construction.
+    } else if (same_nodes) {
       in_pattern_[c] = in_pattern_[c - 1];
     } else {
       row.ForEachEntry([&](int body_a, int a, const Vec3&) {
@@ -165,7 +153,7 @@ void PrimalSolver::LinearizeRows(double h, const std::vector<IslandBody*>& bodie
 
 void PrimalSolver::CollectCurvature(double h, const std::vector<IslandBody*>& bodies,
                                     const std::vector<ConstraintSource*>& sources) {
-  curvature_.clear();
+  curvature_.Clear();
   VecX& weights = curvature_weights_;  // reused across iterations
   weights.setZero(rows_.size());
   bool any = false;
@@ -175,10 +163,10 @@ void PrimalSolver::CollectCurvature(double h, const std::vector<IslandBody*>& bo
     any = true;
   }
   if (!any) return;
-  CurvatureList<CurvatureBlock> sink(curvature_);
   const IslandIterate iterate(h, bodies, v_, rows_.positions());
   for (const ConstraintSource* source : sources)
-    source->AddIslandCurvature(iterate, rows_.rows().data(), weights.data(), rows_.size(), sink);
+    source->AddIslandCurvature(iterate, rows_.rows().data(), weights.data(), rows_.size(),
+                               curvature_);
 }
 
 void PrimalSolver::CalcProjectedMultipliers() {
@@ -203,11 +191,6 @@ void PrimalSolver::CalcProjectedMultipliers() {
     const double y = lambda_bar_[c] - rho_[c] * (g0_[c] + jv_[c]);
     lambda_[c] = ProjectOnInterval(y, LowerBound(row), UpperBound(row), &d_unit_[c]);
   }
-}
-
-void PrimalSolver::AddCurvatureTimes(const std::vector<VecX>& u, std::vector<VecX>& out) const {
-  for (const CurvatureBlock& g : curvature_)
-    out[g.body].segment<3>(3 * g.a) += g.block * u[g.body].segment<3>(3 * g.b);
 }
 
 void PrimalSolver::CalcGradient(const std::vector<IslandBody*>& bodies) {
@@ -255,7 +238,7 @@ int PrimalSolver::AssembleNewtonMatrices(const std::vector<IslandBody*>& bodies)
   // Bodies that keep their factor need no new H: their step is CG on the exact operator.
   if (std::all_of(stale_.begin(), stale_.end(), [](char s) { return s != 0; })) return 0;
   for (IslandBody* body : bodies) body->ResetNewtonMatrix();
-  for (const CurvatureBlock& g : curvature_) bodies[g.body]->AddNewtonBlock(g.a, g.b, g.block);
+  curvature_.AddToNewtonMatrices(bodies);
   // Rows of one element are adjacent and share its nodes: their rho J^T J are summed into one
   // dense element block first and scattered once (group_ below).
   group_.Clear();
@@ -292,7 +275,7 @@ int PrimalSolver::AssembleNewtonMatrices(const std::vector<IslandBody*>& bodies)
   } catch (const SimulationError&) {
     // The curvature is only a metric: without it H = A + sum rho J^T D J is positive definite.
     if (curvature_.empty()) throw;
-    curvature_.clear();
+    curvature_.Clear();
     return factored + AssembleNewtonMatrices(bodies);
   }
   return factored;
@@ -303,6 +286,9 @@ void PrimalSolver::RowGroup::Clear() { num_nodes = 0; }
 bool PrimalSolver::RowGroup::Matches(const ConstraintRow& row) const {
   if (num_nodes == 0 || row.body != body || row.num_nodes + row.num_nodes2 != num_nodes)
     return false;
+  // Rows of one element touch exactly its nodes.
+  if ((row.body2 < 0 ? row.element : -1) != element) return false;
+  if (element >= 0) return true;
   for (int n = 0; n < row.num_nodes; ++n)
     if (row.nodes[n] != nodes[n]) return false;
   for (int n = 0; n < row.num_nodes2; ++n)
@@ -312,6 +298,7 @@ bool PrimalSolver::RowGroup::Matches(const ConstraintRow& row) const {
 
 void PrimalSolver::RowGroup::Start(const ConstraintRow& row) {
   body = row.body;
+  element = row.body2 < 0 ? row.element : -1;
   num_nodes = 0;
   row.ForEachEntry([&](int, int block, const Vec3&) { nodes[num_nodes++] = block; });
   block.setZero(3 * num_nodes, 3 * num_nodes);
@@ -325,6 +312,12 @@ void PrimalSolver::RowGroup::Add(const ConstraintRow& row, double scale) {
 }
 
 void PrimalSolver::RowGroup::Scatter(const std::vector<IslandBody*>& bodies) {
+  if (num_nodes == 0) return;
+  if (element >= 0) {
+    bodies[body]->AddNewtonElementBlock(element, nodes.data(), block);
+    num_nodes = 0;
+    return;
+  }
   for (int a = 0; a < num_nodes; ++a)
     for (int b = 0; b < num_nodes; ++b)
       bodies[body]->AddNewtonBlock(nodes[a], nodes[b], block.block<3, 3>(3 * a, 3 * b));
@@ -354,7 +347,7 @@ void PrimalSolver::AddRowHessianTimes(const std::vector<VecX>& u, std::vector<Ve
 void PrimalSolver::ApplyHessian(const std::vector<IslandBody*>& bodies, const std::vector<VecX>& u,
                                 std::vector<VecX>& out) {
   for (size_t b = 0; b < bodies.size(); ++b) bodies[b]->ApplySystemMatrix(u[b], out[b]);
-  AddCurvatureTimes(u, out);
+  curvature_.AddTimes(u, out);
   AddRowHessianTimes(u, out);
   for (size_t b = 0; b < bodies.size(); ++b)
     for (int i = 0; i < bodies[b]->num_blocks(); ++i)
@@ -440,7 +433,7 @@ double PrimalSolver::SearchModelLine(const std::vector<IslandBody*>& bodies) {
   for (size_t b = 0; b < nb; ++b) bodies[b]->ApplySystemMatrix(v_[b] - bodies[b]->v_star(), hp_[b]);
   const double a0 = Dot(d_, hp_);
   for (size_t b = 0; b < nb; ++b) bodies[b]->ApplySystemMatrix(d_[b], hp_[b]);
-  AddCurvatureTimes(d_, hp_);
+  curvature_.AddTimes(d_, hp_);
   const double a1 = Dot(d_, hp_);
   for (int c = 0; c < rows_.size(); ++c) s_[c] = rows_.CalcRowVelocity(c, d_);
   // psi is convex along d: bracket the root of psi' and close in by safeguarded Newton.
@@ -527,7 +520,7 @@ bool PrimalSolver::TakeNewtonStep(double h, const std::vector<IslandBody*>& bodi
   if (primal.curvature)
     CollectCurvature(h, bodies, sources);
   else
-    curvature_.clear();
+    curvature_.Clear();
   ChooseFactorReuse(bodies, primal);
   stats.newton_factorizations += AssembleNewtonMatrices(bodies);
   stats.pcg_iterations += SolveNewtonStep(bodies, primal);

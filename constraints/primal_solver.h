@@ -8,6 +8,7 @@
 #include <array>
 #include <vector>
 
+#include "constraints/curvature_metric.h"
 #include "constraints/island_rows.h"
 #include "constraints/kkt_certificate.h"
 #include "constraints/sqp_settings.h"
@@ -92,8 +93,6 @@ class PrimalSolver {
   // out = H u (exact operator, matrix-free rows).
   void ApplyHessian(const std::vector<IslandBody*>& bodies, const std::vector<VecX>& u,
                     std::vector<VecX>& out);
-  // out_b += G_b u_b.
-  void AddCurvatureTimes(const std::vector<VecX>& u, std::vector<VecX>& out) const;
   // Step length minimizing the linearized model of Phi along d (root of its convex slope).
   double SearchModelLine(const std::vector<IslandBody*>& bodies);
   // Slope psi'(alpha) and curvature psi''(alpha) of the linearized model along d.
@@ -123,16 +122,13 @@ class PrimalSolver {
   double stale_budget_ = 0.0;   // CG iterations a kept factor may take before a refactor
   bool refactor_next_ = false;  // the last kept factor took too many: refactor
   double violation_ = 0.0;      // largest row violation at the collected rows
-  struct CurvatureBlock {
-    int body, a, b;
-    Mat3 block;
-  };
-  std::vector<CurvatureBlock> curvature_;
+  CurvatureMetric curvature_;
   VecX curvature_weights_;  // h lambda_c of the rows, for the sources' curvature
   // Consecutive rows on the same nodes of one body (one element's rows): their summed
   // rho D J^T J as one dense block, scattered into the Newton matrix once.
   struct RowGroup {
     int body = -1, num_nodes = 0;
+    int element = -1;  // the rows' element (element-local rows), else -1
     std::array<int, 2 * kMaxRowNodes> nodes{};
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6 * kMaxRowNodes, 6 * kMaxRowNodes>
         block;

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "constraints/curvature_blocks.h"
 #include "constraints/strain_limit_curvature.h"
 #include "plugin/tet_rest_data.h"
 
@@ -59,8 +58,10 @@ int StrainLimitConstraint::AppendRows(const VecX& x, int body_index,
     element_rows_.clear();
     const auto xe = tets_.GatherElement(x, e);
     if (IsSurelyInactive(xe, e)) continue;
-    if (AppendStrainLimitRows(e, tets_.rest().elements[e].r, xe,
-                              SelectStrainLimitFrame(settings_, e), params_, &element_rows_) == 0)
+    const TetRestRows& r = tets_.rest().elements[e].r;
+    const SignedSvd& svd = RememberSvd(e, xe, CalcSignedSvd(CalcTetDeformationGradient(r, xe)));
+    if (AppendStrainLimitRows(e, r, svd, SelectStrainLimitFrame(settings_, e), params_,
+                              &element_rows_) == 0)
       continue;
     const int* nodes = tets_.element_nodes(e);
     for (const StrainLimitRow& r : element_rows_) {
@@ -68,6 +69,7 @@ int StrainLimitConstraint::AppendRows(const VecX& x, int body_index,
       row.key = key_.PackFields(r.key.Fields());
       row.C = r.C;
       row.body = body_index;
+      row.element = e;
       row.type = RowType::kStrainLimit;
       row.num_nodes = 4;
       for (int n = 0; n < 4; ++n) {
@@ -88,8 +90,7 @@ void StrainLimitConstraint::AddIslandCurvature(const IslandIterate& iterate,
   SignedSvd svd;
   Mat12 sum = Mat12::Zero();
   const auto flush = [&] {
-    if (element >= 0)
-      AddElementCurvatureBlocks<4>(sum, 1.0, body, tets_.element_nodes(element), sink);
+    if (element >= 0) sink.AddElementBlock(body, element, tets_.element_nodes(element), sum);
   };
   for (int c = 0; c < count; ++c) {
     const ConstraintRow& row = rows[c];
@@ -101,14 +102,32 @@ void StrainLimitConstraint::AddIslandCurvature(const IslandIterate& iterate,
       element = key.element;
       body = row.body;
       sum.setZero();
-      svd = CalcSignedSvd(
-          CalcTetDeformationGradient(r, tets_.GatherElement(iterate.x(row.body), element)));
+      svd = FindOrCalcSvd(element, tets_.GatherElement(iterate.x(row.body), element));
     }
     sum.noalias() +=
         weights[c] * CalcStrainLimitRowCurvature(r, svd, SelectStrainLimitFrame(settings_, element),
                                                  params_, key);
   }
   flush();
+}
+
+const SignedSvd& StrainLimitConstraint::RememberSvd(int e, const TetPositions& xe,
+                                                    const SignedSvd& svd) {
+  if (svd_cache_.size() != static_cast<size_t>(tets_.num_elements()))
+    svd_cache_.assign(tets_.num_elements(), CachedSvd{});
+  CachedSvd& entry = svd_cache_[e];
+  entry.x = xe;
+  entry.svd = svd;
+  entry.valid = true;
+  return entry.svd;
+}
+
+SignedSvd StrainLimitConstraint::FindOrCalcSvd(int e, const TetPositions& xe) const {
+  // The curvature is evaluated at the positions of the last row collection: the same xe, so the
+  // same SVD, bit for bit.
+  if (static_cast<size_t>(e) < svd_cache_.size() && svd_cache_[e].valid && svd_cache_[e].x == xe)
+    return svd_cache_[e].svd;
+  return CalcSignedSvd(CalcTetDeformationGradient(tets_.rest().elements[e].r, xe));
 }
 
 double StrainLimitConstraint::CalcElementViolation(const VecX& x, int e) const {

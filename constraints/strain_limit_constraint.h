@@ -42,6 +42,19 @@ class StrainLimitConstraint final : public BodyConstraintSource {
   // modes; the bound is in the constructor). Saves the SVD of untouched elements.
   bool IsSurelyInactive(const std::array<Vec3, 4>& xe, int e) const;
 
+  // The SVD of element e at positions xe, kept for the curvature at the same positions.
+  const SignedSvd& RememberSvd(int e, const TetPositions& xe, const SignedSvd& svd);
+  // The kept SVD of element e when it was taken at xe, else a fresh one.
+  SignedSvd FindOrCalcSvd(int e, const TetPositions& xe) const;
+
+  // The SVD of each element at the positions of the last AppendRows.
+  struct CachedSvd {
+    TetPositions x;
+    SignedSvd svd;
+    bool valid = false;
+  };
+  std::vector<CachedSvd> svd_cache_;
+
   const DeformableBody& body_;
   const TetElementModel& tets_;
   StrainLimitSettings settings_;

@@ -45,6 +45,7 @@ void ImplicitSystem::Build(const ElementModel& model, const std::vector<NodeKind
   diagonal_.resize(n);
   for (int i = 0; i < n; ++i) diagonal_[i] = index_of(i, i);
   element_map_.assign(static_cast<size_t>(model.num_elements()) * k * k * 9, -1);
+  nodes_per_element_ = k;
   int* map = element_map_.data();
   for (int e = 0; e < model.num_elements(); ++e) {
     const int* nodes = model.element_nodes(e);
@@ -168,6 +169,18 @@ void ImplicitSystem::AddNewtonBlock(int a, int b, const Mat3& block) {
     const int start = A_.outerIndexPtr()[col + c] + offset;
     for (int r = 0; r < 3; ++r) values[start + r] += block(r, c);
   }
+}
+
+void ImplicitSystem::AddNewtonElementBlock(int e, const Eigen::Ref<const MatX>& block) {
+  const int k = nodes_per_element_;
+  TAUT_ASSERT(block.rows() == 3 * k && block.cols() == 3 * k);
+  double* values = H_.valuePtr();
+  const int* map = element_map_.data() + static_cast<size_t>(9 * k * k) * e;
+  for (int a = 0; a < k; ++a)
+    for (int b = 0; b < k; ++b, map += 9)
+      for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r)
+          if (map[3 * c + r] >= 0) values[map[3 * c + r]] += block(3 * a + r, 3 * b + c);
 }
 
 void ImplicitSystem::FactorNewtonMatrix(const std::string& body) {

@@ -73,6 +73,9 @@ class ImplicitSystem {
   // H(a, b) += block on the free DOFs of nodes a and b; a block touching a fixed or kinematic
   // node is dropped. Requires IsInPattern(a, b).
   void AddNewtonBlock(int a, int b, const Mat3& block);
+  // H(nodes of element e) += block (3k x 3k over the element's k nodes, node-major) through the
+  // element's value map; entries on fixed or kinematic nodes are dropped.
+  void AddNewtonElementBlock(int e, const Eigen::Ref<const MatX>& block);
   // Numeric factorization of H; throws SimulationError naming `body` if H is not positive definite.
   void FactorNewtonMatrix(const std::string& body);
   // rhs (3N) <- H^-1 rhs on free DOFs; constrained DOFs set to 0.
@@ -91,6 +94,7 @@ class ImplicitSystem {
   std::vector<int> free_to_dof_;   // (num_free)
   std::vector<int> diagonal_;      // (num_free) value index of A(i,i)
   std::vector<int> element_map_;   // (num_elements x k^2 x 9) value index or -1
+  int nodes_per_element_ = 0;      // k
   Eigen::SparseMatrix<double> A_;  // full symmetric, free DOFs
   LinearSolverKind requested_solver_ = LinearSolverKind::kAuto;
   bool use_cholmod_ = false;

@@ -14,7 +14,6 @@
 #include <tuple>
 #include <vector>
 
-#include "constraints/curvature_blocks.h"
 #include "constraints/deformable_island_body.h"
 #include "constraints/energy_limit_constraint.h"
 #include "constraints/strain_limit_curvature.h"

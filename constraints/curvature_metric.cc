@@ -1,0 +1,53 @@
+#include "constraints/curvature_metric.h"
+
+namespace taut {
+
+void CurvatureMetric::AddBlock(int body, int node_a, int node_b, const Mat3& block) {
+  node_blocks_.push_back({body, node_a, node_b, block});
+}
+
+void CurvatureMetric::AddElementBlock(int body, int element, const int* nodes,
+                                      const Eigen::Ref<const MatX>& block) {
+  const int k = static_cast<int>(block.rows() / 3);
+  TAUT_ASSERT(k <= kMaxRowNodes && block.cols() == block.rows());
+  ElementBlock& e = elements_.emplace_back();
+  e.body = body;
+  e.element = element;
+  e.num_nodes = k;
+  std::copy(nodes, nodes + k, e.nodes.begin());
+  e.offset = values_.size();
+  values_.resize(values_.size() + block.size());
+  Eigen::Map<MatX>(values_.data() + e.offset, block.rows(), block.cols()) = block;
+}
+
+void CurvatureMetric::Clear() {
+  node_blocks_.clear();
+  elements_.clear();
+  values_.clear();
+}
+
+Eigen::Map<const MatX> CurvatureMetric::Block(const ElementBlock& e) const {
+  return Eigen::Map<const MatX>(values_.data() + e.offset, 3 * e.num_nodes, 3 * e.num_nodes);
+}
+
+void CurvatureMetric::AddTimes(const std::vector<VecX>& u, std::vector<VecX>& out) const {
+  for (const NodeBlock& g : node_blocks_)
+    out[g.body].segment<3>(3 * g.a) += g.block * u[g.body].segment<3>(3 * g.b);
+  Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3 * kMaxRowNodes, 1> ue, ge;
+  for (const ElementBlock& e : elements_) {
+    ue.resize(3 * e.num_nodes);
+    for (int n = 0; n < e.num_nodes; ++n)
+      ue.segment<3>(3 * n) = u[e.body].segment<3>(3 * e.nodes[n]);
+    ge.noalias() = Block(e) * ue;
+    for (int n = 0; n < e.num_nodes; ++n)
+      out[e.body].segment<3>(3 * e.nodes[n]) += ge.segment<3>(3 * n);
+  }
+}
+
+void CurvatureMetric::AddToNewtonMatrices(const std::vector<IslandBody*>& bodies) const {
+  for (const NodeBlock& g : node_blocks_) bodies[g.body]->AddNewtonBlock(g.a, g.b, g.block);
+  for (const ElementBlock& e : elements_)
+    bodies[e.body]->AddNewtonElementBlock(e.element, e.nodes.data(), Block(e));
+}
+
+}  // namespace taut
