@@ -195,8 +195,11 @@ void PrimalSolver::CalcProjectedMultipliers() {
 
 void PrimalSolver::CalcGradient(const std::vector<IslandBody*>& bodies) {
   const size_t nb = bodies.size();
-  for (size_t b = 0; b < nb; ++b)
-    bodies[b]->ApplySystemMatrix(v_[b] - bodies[b]->v_star(), grad_[b]);
+  for (size_t b = 0; b < nb; ++b) {
+    w_[b] = v_[b] - bodies[b]->v_star();
+    bodies[b]->ApplySystemMatrix(w_[b], aw_[b]);
+    grad_[b] = aw_[b];
+  }
   for (int c = 0; c < rows_.size(); ++c) {
     if (lambda_[c] == 0.0) continue;
     rows_[c].ForEachEntry([&](int body, int block, const Vec3& J) {
@@ -429,10 +432,11 @@ void PrimalSolver::CalcSlope(double alpha, double a0, double a1, double& slope,
 
 double PrimalSolver::SearchModelLine(const std::vector<IslandBody*>& bodies) {
   const size_t nb = bodies.size();
-  // a0 = d^T A(v - v*), a1 = d^T (A + G) d, s_c = J_c d.
-  for (size_t b = 0; b < nb; ++b) bodies[b]->ApplySystemMatrix(v_[b] - bodies[b]->v_star(), hp_[b]);
-  const double a0 = Dot(d_, hp_);
+  // a0 = d^T A(v - v*) (A(v - v*) from the gradient), a1 = d^T (A + G) d, s_c = J_c d.
+  const double a0 = Dot(d_, aw_);
   for (size_t b = 0; b < nb; ++b) bodies[b]->ApplySystemMatrix(d_[b], hp_[b]);
+  line_dAd_ = Dot(d_, hp_);
+  line_a0_ = a0;
   curvature_.AddTimes(d_, hp_);
   const double a1 = Dot(d_, hp_);
   for (int c = 0; c < rows_.size(); ++c) s_[c] = rows_.CalcRowVelocity(c, d_);
@@ -466,13 +470,19 @@ double PrimalSolver::SearchModelLine(const std::vector<IslandBody*>& bodies) {
 }
 
 double PrimalSolver::CalcMerit(const std::vector<IslandBody*>& bodies, const std::vector<VecX>& v) {
-  // Phi = 1/2 ||v - v*||_A^2 + sum_c P_c(y_c) / rho_c with g_c = C_c/h (friction: J_t v).
-  double phi = 0.0;
+  // Phi = 1/2 ||v - v*||_A^2 + sum_c P_c(y_c) / rho_c.
+  double energy = 0.0;
   for (size_t b = 0; b < bodies.size(); ++b) {
     work_[b] = v[b] - bodies[b]->v_star();
     bodies[b]->ApplySystemMatrix(work_[b], hp_[b]);
-    phi += 0.5 * work_[b].dot(hp_[b]);
+    energy += 0.5 * work_[b].dot(hp_[b]);
   }
+  return energy + CalcRowMerit(v);
+}
+
+double PrimalSolver::CalcRowMerit(const std::vector<VecX>& v) const {
+  // sum_c P_c(y_c) / rho_c with g_c = C_c/h (friction: J_t v).
+  double phi = 0.0;
   for (int c = 0; c < rows_.size(); ++c) {
     const ConstraintRow& row = rows_[c];
     if (rho_[c] <= 0.0 || row.friction_of == 2) continue;
@@ -526,23 +536,22 @@ bool PrimalSolver::TakeNewtonStep(double h, const std::vector<IslandBody*>& bodi
   stats.pcg_iterations += SolveNewtonStep(bodies, primal);
   stats.newton_iterations++;
 
-  // Newton decrement -grad^T d against the scale ||v - v*||_A^2.
+  // Newton decrement -grad^T d against the scale ||v - v*||_A^2 (A(v - v*) from the gradient).
   const double decrement = -Dot(grad_, d_);
-  for (size_t b = 0; b < nb; ++b) {
-    work_[b] = v_[b] - bodies[b]->v_star();
-    bodies[b]->ApplySystemMatrix(work_[b], hp_[b]);
-  }
-  const double scale = Dot(work_, hp_);
+  const double scale = Dot(w_, aw_);
   if (!(decrement > primal.newton_tolerance * std::max(scale, 1e-300))) return false;
   double alpha = SearchModelLine(bodies);
   if (alpha <= 0.0) return false;
-  // Armijo backtracking on the nonlinear Phi (rows re-evaluated at each trial).
-  const double phi0 = CalcMerit(bodies, v_);
+  // Armijo backtracking on the nonlinear Phi (rows re-evaluated at each trial). With w = v - v*
+  // the energy at v + alpha d is 1/2 w^T A w + alpha d^T A w + alpha^2/2 d^T A d (scale = w^T A w
+  // and the two products of the model line search): no product with A per trial.
+  const double phi0 = 0.5 * scale + CalcRowMerit(v_);
   base_.Save(*this);
   for (int halving = 0;; ++halving) {
     for (size_t b = 0; b < nb; ++b) v_trial_[b] = base_.v[b] + alpha * d_[b];
     CollectRowsAt(h, bodies, sources, v_trial_, settings, stats);
-    if (CalcMerit(bodies, v_trial_) <= phi0 - 1e-4 * alpha * decrement) {
+    const double energy = 0.5 * scale + alpha * line_a0_ + 0.5 * alpha * alpha * line_dAd_;
+    if (energy + CalcRowMerit(v_trial_) <= phi0 - 1e-4 * alpha * decrement) {
       return true;
     }
     if (halving >= settings.max_line_search_halvings) break;
@@ -601,11 +610,12 @@ void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
                          KeyedMultipliers& warm, StepStats& stats) {
   const PrimalSettings& primal = settings.primal;
   const size_t nb = bodies.size();
-  for (auto* list : {&v_, &v_trial_, &d_, &grad_, &work_, &r_, &z_, &p_, &hp_}) list->resize(nb);
+  for (auto* list : {&v_, &v_trial_, &d_, &grad_, &work_, &w_, &aw_, &r_, &z_, &p_, &hp_})
+    list->resize(nb);
   std::vector<VecX> start(nb);
   for (size_t b = 0; b < nb; ++b) {
     start[b] = bodies[b]->v();
-    for (auto* list : {&v_, &v_trial_, &d_, &grad_, &work_, &r_, &z_, &p_, &hp_})
+    for (auto* list : {&v_, &v_trial_, &d_, &grad_, &work_, &w_, &aw_, &r_, &z_, &p_, &hp_})
       (*list)[b].setZero(start[b].size());
   }
   iterate_ = settings.warm_start ? warm : KeyedMultipliers();

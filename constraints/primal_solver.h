@@ -99,6 +99,8 @@ class PrimalSolver {
   void CalcSlope(double alpha, double a0, double a1, double& slope, double& curvature) const;
   // Phi at the collected rows and velocities v (lambda_bar, rho as collected).
   double CalcMerit(const std::vector<IslandBody*>& bodies, const std::vector<VecX>& v);
+  // Its row part sum_c P_c(y_c) / rho_c.
+  double CalcRowMerit(const std::vector<VecX>& v) const;
   // Adds scale * J_p^T J_q (same-body blocks) to the bodies' Newton matrices.
   void AddRowProduct(const std::vector<IslandBody*>& bodies, int p, int q, double scale);
   // out += rho D J^T (J u) over the rows (H's row part, matrix-free).
@@ -119,9 +121,10 @@ class PrimalSolver {
   bool coupled_ = false;                 // some row is two-sided or off-pattern: PCG
   std::vector<char> stale_;              // body keeps its last factor (ChooseFactorReuse)
   bool any_stale_ = false;
-  double stale_budget_ = 0.0;   // CG iterations a kept factor may take before a refactor
-  bool refactor_next_ = false;  // the last kept factor took too many: refactor
-  double violation_ = 0.0;      // largest row violation at the collected rows
+  double stale_budget_ = 0.0;              // CG iterations a kept factor may take before a refactor
+  bool refactor_next_ = false;             // the last kept factor took too many: refactor
+  double violation_ = 0.0;                 // largest row violation at the collected rows
+  double line_a0_ = 0.0, line_dAd_ = 0.0;  // d^T A (v - v*) and d^T A d of the model line search
   CurvatureMetric curvature_;
   VecX curvature_weights_;  // h lambda_c of the rows, for the sources' curvature
   // Consecutive rows on the same nodes of one body (one element's rows): their summed
@@ -140,6 +143,7 @@ class PrimalSolver {
   };
   RowGroup group_;
   std::vector<VecX> v_, v_trial_, d_, grad_, work_, r_, z_, p_, hp_;
+  std::vector<VecX> w_, aw_;  // v - v* and A (v - v*) at the Newton iterate (CalcGradient)
   // The rows and velocities of the line search's base point (restored when no trial is taken).
   struct BasePoint {
     IslandRows rows;
