@@ -13,7 +13,18 @@ struct SignedSvd {
   Mat3 V;
 };
 
-// Computes the signed SVD of G (docs/math.md §0.2: flip u_3 / v_3 and s_3 when det U or det V < 0).
+// Computes the signed SVD of G in the convention of docs/math.md §0.2 (the ordinary SVD with its
+// sign fixes), by the structure of McAdams et al. 2011 in double precision with exact rotations:
+// G is scaled by a power of two to max |G_ij| in [1, 2); cyclic Jacobi diagonalizes G^T G =
+// V diag(s^2) V^T (sorted descending); Givens QR of G V = U R gives s = diag(R), where R is
+// diagonal up to round-off (its trailing 2x2 block is diagonalized once more when s_2 and s_3 are
+// both below ~sqrt(eps) s_1). Signs are moved so that s_1, s_2 >= 0 and s_3 carries sign(det G).
+// U and V are rotations for every finite G, rank-deficient ones included (G = 0: U = V = I,
+// s = 0). A diagonal G with d_1 >= d_2 >= |d_3| gives U = V = I and s = d exactly; other diagonal
+// G give signed permutation matrices and the sorted |d|. A non-finite G gives NaN in U, s and V.
+// Accuracy (tests/signed_svd_test.cc): ||U diag(s) V^T - G||, ||U^T U - I|| and ||V^T V - I||
+// of a few 1e-15 relative to ||G||; s within a few 1e-15 s_1 of Eigen's JacobiSVD, and a
+// sliver's s_3 = 1e-6 s_1 to ~1e-10 relative.
 SignedSvd CalcSignedSvd(const Mat3& G);
 
 // Rotation of the polar decomposition G = R S taken from the signed SVD: R = U V^T (det R = +1,
