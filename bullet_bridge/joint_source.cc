@@ -122,12 +122,6 @@ int JointSource::AppendIslandRows(const IslandIterate& iterate, std::vector<Cons
   return static_cast<int>(rows_.size());
 }
 
-double JointSource::CalcIslandMaxViolation(const IslandIterate& iterate) const {
-  double violation = 0.0;
-  for (const JointRow& row : rows_) violation = std::max(violation, CalcViolation(iterate, row));
-  return violation;
-}
-
 double JointSource::CalcIslandViolationSum(const IslandIterate& iterate) const {
   double sum = 0.0;
   for (const JointRow& row : rows_) sum += CalcViolation(iterate, row);

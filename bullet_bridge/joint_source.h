@@ -31,7 +31,6 @@ class JointSource final : public ConstraintSource {
   int num_rows() const { return static_cast<int>(rows_.size()); }
 
   int AppendIslandRows(const IslandIterate& iterate, std::vector<ConstraintRow>& rows) override;
-  double CalcIslandMaxViolation(const IslandIterate& iterate) const override;
   double CalcIslandViolationSum(const IslandIterate& iterate) const override;
 
  private:

@@ -64,17 +64,6 @@ int NodeAttachmentSource::AppendIslandRows(const IslandIterate& iterate,
   return static_cast<int>(3 * nodes_.size());
 }
 
-double NodeAttachmentSource::CalcIslandMaxViolation(const IslandIterate& iterate) const {
-  const VecX& x = iterate.x(iterate.IndexOf(&body_));
-  Vec3 com;
-  CalcAnchors(iterate, anchors_, com);
-  double violation = 0.0;
-  for (size_t k = 0; k < nodes_.size(); ++k)
-    violation =
-        std::max(violation, (x.segment<3>(3 * nodes_[k]) - anchors_[k]).cwiseAbs().maxCoeff());
-  return violation;
-}
-
 double NodeAttachmentSource::CalcIslandViolationSum(const IslandIterate& iterate) const {
   const VecX& x = iterate.x(iterate.IndexOf(&body_));
   Vec3 com;

@@ -22,7 +22,6 @@ class NodeAttachmentSource final : public ConstraintSource {
 
   const RigidIslandBody* rigid() const { return rigid_; }
   int AppendIslandRows(const IslandIterate& iterate, std::vector<ConstraintRow>& rows) override;
-  double CalcIslandMaxViolation(const IslandIterate& iterate) const override;
   double CalcIslandViolationSum(const IslandIterate& iterate) const override;
 
  private:

@@ -114,15 +114,6 @@ double RigidContactSource::CalcPointGap(const IslandIterate& iterate, const Vec3
   return gap;
 }
 
-double RigidContactSource::CalcIslandMaxViolation(const IslandIterate& iterate) const {
-  const VecX& x = iterate.x(iterate.IndexOf(&body_));
-  double violation = 0.0;
-  for (const ContactPoint& point : points_)
-    if (Moves(point))
-      violation = std::max(violation, -CalcPointGap(iterate, CalcContactPointPosition(point, x)));
-  return violation;
-}
-
 double RigidContactSource::CalcIslandViolationSum(const IslandIterate& iterate) const {
   const VecX& x = iterate.x(iterate.IndexOf(&body_));
   double sum = 0.0;

@@ -42,7 +42,6 @@ class RigidContactSource final : public ConstraintSource {
   void set_objects(const std::vector<const btCollisionObject*>& objects);
 
   int AppendIslandRows(const IslandIterate& iterate, std::vector<ConstraintRow>& rows) override;
-  double CalcIslandMaxViolation(const IslandIterate& iterate) const override;
   double CalcIslandViolationSum(const IslandIterate& iterate) const override;
 
  private:

@@ -113,13 +113,6 @@ int RigidManifoldSource::AppendIslandRows(const IslandIterate& iterate,
   return static_cast<int>(rows.size()) - before;
 }
 
-double RigidManifoldSource::CalcIslandMaxViolation(const IslandIterate& iterate) const {
-  double violation = 0.0;
-  for (const RigidContactPoint& p : points_)
-    violation = std::max(violation, -CalcNormalC(iterate, p));
-  return violation;
-}
-
 double RigidManifoldSource::CalcIslandViolationSum(const IslandIterate& iterate) const {
   double sum = 0.0;
   for (const RigidContactPoint& p : points_) sum += std::max(0.0, -CalcNormalC(iterate, p));

@@ -46,7 +46,6 @@ class RigidManifoldSource final : public ConstraintSource {
   int num_points() const { return static_cast<int>(points_.size()); }
 
   int AppendIslandRows(const IslandIterate& iterate, std::vector<ConstraintRow>& rows) override;
-  double CalcIslandMaxViolation(const IslandIterate& iterate) const override;
   double CalcIslandViolationSum(const IslandIterate& iterate) const override;
 
  private:

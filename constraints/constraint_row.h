@@ -110,8 +110,6 @@ class ConstraintSource {
   // Appends the rows active at the iterate (violated or within the activation margin). Returns
   // how many were appended.
   virtual int AppendIslandRows(const IslandIterate& iterate, std::vector<ConstraintRow>& rows) = 0;
-  // Largest violation (max(0, -C), bilateral |C|) over every constraint of the source.
-  virtual double CalcIslandMaxViolation(const IslandIterate& iterate) const = 0;
   // Sum of violations over every constraint (the merit function's penalty).
   virtual double CalcIslandViolationSum(const IslandIterate& iterate) const = 0;
 };
@@ -134,9 +132,6 @@ class BodyConstraintSource : public ConstraintSource {
   int AppendIslandRows(const IslandIterate& iterate, std::vector<ConstraintRow>& rows) override {
     const int b = iterate.IndexOf(&body());
     return AppendRows(iterate.x(b), b, rows);
-  }
-  double CalcIslandMaxViolation(const IslandIterate& iterate) const override {
-    return CalcMaxViolation(iterate.x(iterate.IndexOf(&body())));
   }
   double CalcIslandViolationSum(const IslandIterate& iterate) const override {
     return CalcViolationSum(iterate.x(iterate.IndexOf(&body())));

@@ -160,13 +160,6 @@ int DeformableContactSource::AppendIslandRows(const IslandIterate& iterate,
   return static_cast<int>(rows.size()) - before;
 }
 
-double DeformableContactSource::CalcIslandMaxViolation(const IslandIterate& iterate) const {
-  FindHits(iterate.x(iterate.IndexOf(&a_)), iterate.x(iterate.IndexOf(&b_)));
-  double violation = 0.0;
-  for (const Hit& hit : hits_) violation = std::max(violation, -hit.gap);
-  return violation;
-}
-
 double DeformableContactSource::CalcIslandViolationSum(const IslandIterate& iterate) const {
   FindHits(iterate.x(iterate.IndexOf(&a_)), iterate.x(iterate.IndexOf(&b_)));
   double sum = 0.0;

@@ -28,7 +28,6 @@ class DeformableContactSource final : public ConstraintSource {
   const DeformableBody& body_a() const { return a_; }
   const DeformableBody& body_b() const { return b_; }
   int AppendIslandRows(const IslandIterate& iterate, std::vector<ConstraintRow>& rows) override;
-  double CalcIslandMaxViolation(const IslandIterate& iterate) const override;
   double CalcIslandViolationSum(const IslandIterate& iterate) const override;
 
  private:

@@ -42,9 +42,16 @@ double CalcPenetration(const DeformableBody& a, const DeformableBody& b, const T
   DeformableIslandBody ia(ma), ib(mb);
   const std::vector<IslandBody*> bodies = {&ia, &ib};
   const std::vector<VecX> v = {a.v(), b.v()}, x = {a.x(), b.x()};
-  const DeformableContactSource source(a, MakeTetContactSurface(mesh_a), b,
-                                       MakeTetContactSurface(mesh_b), 1, 0.0, 0.05);
-  return source.CalcIslandMaxViolation(IslandIterate(0.0, bodies, v, x));
+  DeformableContactSource source(a, MakeTetContactSurface(mesh_a), b, MakeTetContactSurface(mesh_b),
+                                 1, 0.0, 0.05);
+  // The normal rows' C is the signed gap of each surface point (penetrating points are always
+  // within the activation margin, so they all emit rows).
+  std::vector<ConstraintRow> rows;
+  source.AppendIslandRows(IslandIterate(0.0, bodies, v, x), rows);
+  double penetration = 0.0;
+  for (const ConstraintRow& row : rows)
+    if (row.friction_of == 0) penetration = std::max(penetration, -row.C);
+  return penetration;
 }
 
 // Settings of a soft cube.

@@ -38,7 +38,6 @@ class FixedStrainRows final : public ConstraintSource {
     }
     return static_cast<int>(keys_.size());
   }
-  double CalcIslandMaxViolation(const IslandIterate& /*iterate*/) const override { return 0.0; }
   double CalcIslandViolationSum(const IslandIterate& /*iterate*/) const override { return 0.0; }
   std::uint64_t Key(int element, int axis, int principal_axis, int bound) const {
     return packer_.Pack(element, axis, principal_axis, bound);
