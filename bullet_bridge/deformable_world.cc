@@ -111,9 +111,9 @@ DeformableBody* DeformableWorld::AddDeformableBody(std::unique_ptr<DeformableBod
   entry->island_body = std::make_unique<DeformableIslandBody>(entry->object->body());
   DeformableBody& added = entry->object->body();
   entry->surface = MakeBodyContactSurface(added.model());
-  entry->contacts = std::make_unique<RigidContactSource>(added, entry->surface, next_source_id_++,
-                                                         added.settings().friction,
-                                                         added.settings().contact_margin);
+  entry->contacts = std::make_unique<RigidContactSource>(
+      added, entry->surface, next_source_id_++, added.settings().friction,
+      added.settings().contact_margin, added.settings().restitution);
   bodies_.push_back(std::move(entry));
   addCollisionObject(&bodies_.back()->collision_object(), btBroadphaseProxy::DefaultFilter,
                      btBroadphaseProxy::AllFilter);
@@ -362,8 +362,19 @@ void DeformableWorld::FindRigidPartners(Entry& entry, double reach) {
 
 void DeformableWorld::FindDeformablePairs() {
   active_pairs_.clear();
+  // The pair's source is kept across steps for its warm starts.
+  auto activate = [this](int d, int e) {
+    PairContact& pair = pair_contacts_[{bodies_[d].get(), bodies_[e].get()}];
+    if (pair.source == nullptr) {
+      pair.source_id = next_source_id_++;
+      pair.source = MakePairContactSource(*bodies_[d], *bodies_[e], pair.source_id);
+    }
+    active_pairs_.push_back({d, e, pair.source.get()});
+  };
   const int num_deformables = static_cast<int>(bodies_.size());
   for (int d = 0; d < num_deformables; ++d) {
+    // Self-contact (opt-in): the body as both sides, every step (its own spatial hash culls).
+    if (bodies_[d]->body().settings().self_collision) activate(d, d);
     for (int e = d + 1; e < num_deformables; ++e) {
       const Entry& first = *bodies_[d];
       const Entry& second = *bodies_[e];
@@ -372,19 +383,22 @@ void DeformableWorld::FindDeformablePairs() {
         continue;
       if (!ShouldCollide(first.object->collision_object(), second.object->collision_object()))
         continue;
-      // The pair's source is kept across steps for its warm starts.
-      auto& source = pair_contacts_[{&first, &second}];
-      if (source == nullptr) {
-        const DeformableBodySettings& a = first.object->body().settings();
-        const DeformableBodySettings& b = second.object->body().settings();
-        source = std::make_unique<DeformableContactSource>(
-            first.object->body(), first.surface, second.object->body(), second.surface,
-            next_source_id_++, a.friction * b.friction,
-            std::max(a.contact_margin, b.contact_margin));
-      }
-      active_pairs_.push_back({d, e, source.get()});
+      activate(d, e);
     }
   }
+}
+
+std::unique_ptr<DeformableContactSource> DeformableWorld::MakePairContactSource(
+    const Entry& first, const Entry& second, int source_id) const {
+  const DeformableBodySettings& a = first.object->body().settings();
+  const DeformableBodySettings& b = second.object->body().settings();
+  if (&first == &second)  // self-contact: the body's boundary (not an embedded contact surface)
+    return std::make_unique<DeformableContactSource>(
+        first.object->body(), MakeBodyContactSurface(first.object->body().model()), source_id,
+        a.friction * a.friction, a.contact_margin);
+  return std::make_unique<DeformableContactSource>(
+      first.object->body(), first.surface, second.object->body(), second.surface, source_id,
+      a.friction * b.friction, std::max(a.contact_margin, b.contact_margin));
 }
 
 void DeformableWorld::UniteIslands() {
@@ -448,6 +462,7 @@ void DeformableWorld::GatherRowSources(const btContactSolverInfo& info) {
     for (auto& source : entry->sources) island.sources.push_back(source.get());
     if (!entry->partners.empty()) {
       entry->contacts->set_partners(entry->partners);
+      entry->contacts->set_restitution_threshold(info.m_restitutionVelocityThreshold);
       island.sources.push_back(entry->contacts.get());
     }
     for (auto& attachment : entry->dynamic_attachments) island.sources.push_back(attachment.get());

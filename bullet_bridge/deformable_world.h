@@ -17,6 +17,7 @@
 #include "bullet_bridge/rigid_contact_source.h"
 #include "bullet_bridge/rigid_island_body.h"
 #include "bullet_bridge/rigid_manifold_source.h"
+#include "bullet_bridge/world_snapshot.h"
 #include "constraints/deformable_contact_source.h"
 #include "constraints/deformable_island_body.h"
 #include "constraints/energy_limit_constraint.h"
@@ -130,6 +131,17 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   // when the body is not in this world.
   std::vector<LimitRowMultiplier> last_limit_multipliers(const DeformableBody* body) const;
 
+  // State snapshots (bullet_bridge/world_snapshot.h), between stepSimulation calls: everything
+  // the next step depends on (deformables, warm starts, rigid bodies, joints, Bullet's contact
+  // manifolds, the substep clock, the last step's statistics and forces), so a restored world
+  // continues bit-identically to the one it was saved from. A snapshot fits this world and any
+  // world built the same way (same bodies, objects and joints in the same order).
+  WorldSnapshot SaveSnapshot() const;
+  // Throws InputError saying what does not match, and changes nothing, when the snapshot is of a
+  // world with other deformables (count, nodes, elements), collision objects (count, kind,
+  // shape) or joints.
+  void RestoreSnapshot(const WorldSnapshot& snapshot);
+
  protected:
   // One fixed substep; Bullet's sequence calls solveConstraints below between collision
   // detection and the integration of the rigid transforms.
@@ -162,9 +174,10 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
     DeformableBody& body() { return object->body(); }
     btCollisionObject& collision_object() { return object->collision_object(); }
   };
-  // Two deformables whose swept bounds overlap this step, with their contact source.
+  // Two deformables whose swept bounds overlap this step, with their contact source; or one
+  // body with self_collision, both sides itself.
   struct DeformablePair {
-    int first, second;  // entry indices, first < second
+    int first, second;  // entry indices, first < second (first == second: self-contact)
     DeformableContactSource* source;
   };
   // Stages of the substep (docs/architecture.md §3), in order; `begun` counts the bodies whose step
@@ -212,12 +225,22 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   // Installs `source` on the body's entry, replacing any earlier source of the same type T.
   template <typename T>
   T* ReplaceSource(DeformableBody* body, std::unique_ptr<T> source);
+  // The contact source of two deformables (friction and margin from their settings), or of one
+  // body's self-contact when first and second are the same entry.
+  std::unique_ptr<DeformableContactSource> MakePairContactSource(const Entry& first,
+                                                                 const Entry& second,
+                                                                 int source_id) const;
+  // The stages of SaveSnapshot and RestoreSnapshot (bullet_bridge/world_snapshot.cc).
+  struct Snapshots;
 
   std::vector<std::unique_ptr<Entry>> bodies_;
   std::unordered_map<const btCollisionObject*, std::unique_ptr<RigidIslandBody>> rigid_bodies_;
   // Contact sources of deformable pairs (kept across steps for warm starts), and this step's.
-  std::map<std::pair<const Entry*, const Entry*>, std::unique_ptr<DeformableContactSource>>
-      pair_contacts_;
+  struct PairContact {
+    int source_id = -1;
+    std::unique_ptr<DeformableContactSource> source;
+  };
+  std::map<std::pair<const Entry*, const Entry*>, PairContact> pair_contacts_;
   std::vector<DeformablePair> active_pairs_;
   IslandBuilder islands_;                  // this step's islands
   std::vector<RigidIslandBody*> coupled_;  // rigid bodies in deformable islands, this step

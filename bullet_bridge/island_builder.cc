@@ -71,6 +71,27 @@ void IslandBuilder::MakeDeformableIslands(int& next_source_id) {
   }
 }
 
+std::vector<std::array<int, 2>> IslandBuilder::SaveSourceIds() const {
+  std::vector<std::array<int, 2>> ids;
+  for (const Island& island : islands_)
+    ids.push_back({island.manifolds->source_id(), island.joints->source_id()});
+  return ids;
+}
+
+void IslandBuilder::RestoreSourceIds(const std::vector<std::array<int, 2>>& ids) {
+  islands_.resize(ids.size());
+  for (size_t i = 0; i < ids.size(); ++i) {
+    Island& island = islands_[i];
+    island.bodies.clear();
+    island.sources.clear();
+    if (island.manifolds == nullptr || island.manifolds->source_id() != ids[i][0])
+      island.manifolds = std::make_unique<RigidManifoldSource>(ids[i][0]);
+    if (island.joints == nullptr || island.joints->source_id() != ids[i][1])
+      island.joints = std::make_unique<JointSource>(ids[i][1]);
+  }
+  num_islands_ = 0;
+}
+
 int IslandBuilder::IslandOf(int index) {
   const int root = union_find_.Find(index);
   return root < num_deformables_ ? island_of_root_[root] : -1;

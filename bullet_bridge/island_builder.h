@@ -6,6 +6,7 @@
 #include <BulletDynamics/Dynamics/btDynamicsWorld.h>
 #include <BulletDynamics/Dynamics/btRigidBody.h>
 
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -50,6 +51,13 @@ class IslandBuilder {
   // Makes one island per set holding a deformable, emptied for this step; `next_source_id`
   // numbers the manifold and joint sources of islands made for the first time.
   void MakeDeformableIslands(int& next_source_id);
+
+  // Source ids of the manifold and joint sources of every island slot made so far (slots are
+  // reused by later steps, so their ids are part of the world's state: world snapshots).
+  std::vector<std::array<int, 2>> SaveSourceIds() const;
+  // Makes the slots those of SaveSourceIds (recreating a source whose id differs) and forgets
+  // this step's islands (num_islands() = 0 until the next MakeDeformableIslands).
+  void RestoreSourceIds(const std::vector<std::array<int, 2>>& ids);
 
   int num_islands() const { return num_islands_; }
   Island& island(int i) { return islands_[i]; }

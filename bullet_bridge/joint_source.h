@@ -21,6 +21,7 @@ class JointSource final : public ConstraintSource {
  public:
   // `source_id` < 2^16 (row keys).
   explicit JointSource(int source_id) : key_(kJointRowKey, source_id) {}
+  int source_id() const { return key_.source_id(); }
 
   // Clears the rows (start of a step).
   void Clear() { rows_.clear(); }

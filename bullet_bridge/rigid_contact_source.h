@@ -26,9 +26,10 @@ class RigidContactSource final : public ConstraintSource {
   // `friction` is the body's Coulomb coefficient, combined with each object's by the product
   // (Bullet's default combiner); `margin` [m] is how close a point must be to get rows. The
   // contact points are those of `surface` (usually MakeBodyContactSurface(body.model()));
-  // `source_id` < 2^16 (row keys).
+  // `source_id` < 2^16 (row keys). `restitution` in [0, 1] is the body's Newton restitution,
+  // combined with each object's getRestitution() by the product (Bullet's default combiner).
   RigidContactSource(const DeformableBody& body, const ContactSurface& surface, int source_id,
-                     double friction, double margin);
+                     double friction, double margin, double restitution = 0.0);
 
   // Replaces the contact points (e.g. a surface embedded in a hex body: 8-node rows). Points
   // whose nodes are all fixed or kinematic get no rows.
@@ -40,6 +41,10 @@ class RigidContactSource final : public ConstraintSource {
   const std::vector<ContactPartner>& partners() const { return partners_; }
   // Immovable partners only (convenience for static scenes and tests).
   void set_objects(const std::vector<const btCollisionObject*>& objects);
+  // Approach speed [m/s] above which restitution applies (Bullet's
+  // btContactSolverInfo::m_restitutionVelocityThreshold, default 0.2 m/s), so resting contacts,
+  // which approach at about g h per step, stay at rest.
+  void set_restitution_threshold(double speed) { restitution_threshold_ = speed; }
 
   int AppendIslandRows(const IslandIterate& iterate, std::vector<ConstraintRow>& rows) override;
   double CalcIslandViolationSum(const IslandIterate& iterate) const override;
@@ -49,13 +54,36 @@ class RigidContactSource final : public ConstraintSource {
   btTransform CalcPartnerTransform(const IslandIterate& iterate, size_t o) const;
   // True when a node of the point moves freely.
   bool Moves(const ContactPoint& point) const;
-  // Smallest gap of point p over the partners at the iterate (+inf when none is within the margin).
-  double CalcPointGap(const IslandIterate& iterate, const Vec3& p) const;
+  // Smallest normal-row C of point i (at p) over the partners at the iterate: the gap, or the
+  // restitution C of a closing contact (+inf when no partner is near).
+  double CalcPointGap(const IslandIterate& iterate, size_t i, const Vec3& p) const;
+  // What the rows against one partner share at an iterate.
+  struct PartnerRows {
+    int body_index;      // the deformable's island index
+    int rigid_index;     // the partner's island index, -1 when immovable
+    bool outside_world;  // key fields: the object in no world, keyed by its partner position
+    int object_id;
+    double mu;           // combined friction
+    double restitution;  // combined restitution e
+  };
+  // Partner o's shared row data at the iterate.
+  PartnerRows MakePartnerRows(const IslandIterate& iterate, size_t o) const;
+  // The row of direction d (k = 0 normal, 1-2 friction tangents) of point i against a partner
+  // whose surface point is its centre of mass + r.
+  void FillRow(const PartnerRows& partner, size_t i, const Vec3& d, const Vec3& r, int k,
+               ConstraintRow& row) const;
+  // C of a normal row with combined restitution e > 0 (docs/math.md §5.5): when the contact
+  // approaches at v* faster than the threshold (approach = -J v*) and would close within the
+  // step (gap + h J (v* - v) < 0), C = min(gap, h (J v - e approach)); else the gap.
+  double CalcRestitutionC(const IslandIterate& iterate, const ConstraintRow& normal, double gap,
+                          double e) const;
 
   const DeformableBody& body_;
   RowKeyPacker<4> key_;  // kRigidContactRowKey with this source's id
   double friction_;
   double margin_;
+  double restitution_;
+  double restitution_threshold_ = 0.2;  // [m/s], Bullet's default
   std::vector<ContactPoint> points_;
   std::vector<ContactPartner> partners_;
 };

@@ -34,6 +34,7 @@ class RigidManifoldSource final : public ConstraintSource {
  public:
   // `source_id` < 2^16 (row keys).
   explicit RigidManifoldSource(int source_id) : key_(kRigidManifoldRowKey, source_id) {}
+  int source_id() const { return key_.source_id(); }
 
   // Clears the points (start of a step).
   void Clear() { points_.clear(); }

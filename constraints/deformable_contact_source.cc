@@ -66,6 +66,20 @@ DeformableContactSource::DeformableContactSource(const DeformableBody& a,
               "': contact margin must be finite and > 0 m, got ", margin);
 }
 
+DeformableContactSource::DeformableContactSource(const DeformableBody& body,
+                                                 const ContactSurface& surface, int source_id,
+                                                 double friction, double margin)
+    : a_(body),
+      b_(body),
+      surfaces_{surface, surface},
+      key_(kDeformableContactRowKey, source_id),
+      friction_(friction),
+      margin_(margin) {
+  TAUT_DEMAND(std::isfinite(friction) && friction >= 0.0, "body '", body.name(),
+              "': self-contact friction must be finite and >= 0, got ", friction);
+  self_ = std::make_unique<SelfContactSearch>(body, surface, margin);
+}
+
 bool DeformableContactSource::FindNearestTriangle(const ContactSurface& surface, const VecX& x,
                                                   const Vec3& p, Hit& hit) const {
   double best = margin_;
@@ -95,6 +109,17 @@ bool DeformableContactSource::FindNearestTriangle(const ContactSurface& surface,
 }
 
 void DeformableContactSource::FindHits(const VecX& xa, const VecX& xb) const {
+  if (self_ == nullptr) {
+    FindPairHits(xa, xb);
+    return;
+  }
+  self_->FindHits(xa, self_hits_);
+  hits_.clear();
+  for (const SelfContactSearch::Hit& hit : self_hits_)
+    hits_.push_back({0, hit.point, hit.triangle, hit.normal, hit.beta, hit.gap});
+}
+
+void DeformableContactSource::FindPairHits(const VecX& xa, const VecX& xb) const {
   hits_.clear();
   const VecX* x[2] = {&xa, &xb};
   for (int direction = 0; direction < 2; ++direction) {

@@ -1,12 +1,16 @@
 // Contact between two deformable bodies: the contact points of each body against the surface
 // triangles of the other (vertex-triangle), as normal rows C = gap >= 0 with two Coulomb
-// friction rows on the disk (docs/math.md §5.5), coupling both bodies in one island.
+// friction rows on the disk (docs/math.md §5.5), coupling both bodies in one island. Also the
+// self-contact of one body: its boundary nodes against its own boundary triangles, in the same
+// rows.
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include "constraints/constraint_row.h"
 #include "constraints/row_key_layouts.h"
+#include "constraints/self_contact_search.h"
 #include "plugin/contact_surface.h"
 
 namespace taut {
@@ -24,7 +28,16 @@ class DeformableContactSource final : public ConstraintSource {
   DeformableContactSource(const DeformableBody& a, const ContactSurface& surface_a,
                           const DeformableBody& b, const ContactSurface& surface_b, int source_id,
                           double friction, double margin);
+  // Self-contact of `body` (docs/math.md §5.5, self-contact): the points of `surface` (single
+  // nodes with node triangles, e.g. MakeBodyContactSurface(body.model())) against its own
+  // triangles, the admissible pairs of SelfContactSearch (rest exclusion, facing, margin). Both
+  // sides of a row are the body; keys have direction 0. `friction` is the combined coefficient
+  // (the world uses the body's squared, the product rule of a pair).
+  DeformableContactSource(const DeformableBody& body, const ContactSurface& surface, int source_id,
+                          double friction, double margin);
 
+  // True for the self-contact of one body.
+  bool is_self_contact() const { return self_ != nullptr; }
   const DeformableBody& body_a() const { return a_; }
   const DeformableBody& body_b() const { return b_; }
   int AppendIslandRows(const IslandIterate& iterate, std::vector<ConstraintRow>& rows) override;
@@ -38,8 +51,10 @@ class DeformableContactSource final : public ConstraintSource {
     Vec3 normal, beta;
     double gap;
   };
-  // Every point-triangle contact within the margin at positions xa, xb.
+  // Every point-triangle contact within the margin at positions xa, xb (self-contact: xa).
   void FindHits(const VecX& xa, const VecX& xb) const;
+  // The pair's contacts: both directions, every triangle of the other body tested.
+  void FindPairHits(const VecX& xa, const VecX& xb) const;
   // Nearest triangle of `surface` (positions x) to p within the margin; false when none.
   bool FindNearestTriangle(const ContactSurface& surface, const VecX& x, const Vec3& p,
                            Hit& hit) const;
@@ -49,7 +64,9 @@ class DeformableContactSource final : public ConstraintSource {
   ContactSurface surfaces_[2];
   RowKeyPacker<4> key_;  // kDeformableContactRowKey with this source's id
   double friction_, margin_;
-  mutable std::vector<Hit> hits_;  // scratch of the last FindHits
+  std::unique_ptr<SelfContactSearch> self_;  // self-contact only
+  mutable std::vector<Hit> hits_;            // scratch of the last FindHits
+  mutable std::vector<SelfContactSearch::Hit> self_hits_;
 };
 
 namespace internal {

@@ -29,6 +29,20 @@ class IslandSolver {
   // `primal_steps_left` > 0 after a failed dual step.
   static IslandSolverKind ChooseAuto(int rows, int free_dofs, int primal_steps_left = 0);
 
+  // What the next Solve depends on from earlier ones: the warm starts by row key and the path
+  // rule's memory. Saved and restored by world snapshots (bullet_bridge/world_snapshot.h).
+  struct State {
+    KeyedMultipliers warm;      // last step's multipliers by row key
+    int last_rows = 0;          // rows at the end of the last step
+    int primal_steps_left = 0;  // steps the primal path keeps after a dual failure
+  };
+  State SaveState() const { return {warm_, last_rows_, primal_steps_left_}; }
+  void RestoreState(const State& state) {
+    warm_ = state.warm;
+    last_rows_ = state.last_rows;
+    primal_steps_left_ = state.primal_steps_left;
+  }
+
   // The rows of the last Solve at its final velocities and their multipliers, one per row
   // (contact rows: impulses [N s]; limit rows [N m s]), from the path that ran. Reading them
   // changes nothing; valid until the next Solve.

@@ -33,7 +33,8 @@ inline constexpr RowKeyLayout<1> kEnergyLimitRowKey{
         {"element", 31},  // element index (any int >= 0)
     }}};
 
-// DeformableContactSource: a contact point of one body against a surface triangle of the other.
+// DeformableContactSource: a contact point of one body against a surface triangle of the other
+// (self-contact: direction 0, a boundary node against a triangle of the same body's boundary).
 inline constexpr RowKeyLayout<4> kDeformableContactRowKey{
     "deformable contact",
     {{

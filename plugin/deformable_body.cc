@@ -230,6 +230,47 @@ void DeformableBody::FailStep(const std::string& what, const char* stage) {
                                          "); state kept at step start"));
 }
 
+DeformableBody::State DeformableBody::SaveState() const {
+  State state;
+  state.x = x_;
+  state.v = v_;
+  state.external = external_;
+  state.kinds = kinds_;
+  state.kinematic_targets = kinematic_targets_;
+  state.kinds_changed = kinds_changed_;
+  if (!kinds_changed_) state.newton = system_.SaveNewtonState();
+  return state;
+}
+
+void DeformableBody::RestoreState(const State& state) {
+  const size_t n = static_cast<size_t>(num_nodes());
+  TAUT_DEMAND(state.x.size() == x_.size() && state.v.size() == v_.size() &&
+                  state.external.size() == external_.size() && state.kinds.size() == n &&
+                  state.kinematic_targets.size() == n,
+              "body '", name(), "': RestoreState: the state is of a body with ", state.x.size() / 3,
+              " nodes, this one has ", n);
+  if (!state.kinds_changed) RestoreSystem(state);
+  x_ = state.x;
+  v_ = state.v;
+  external_ = state.external;
+  kinds_ = state.kinds;
+  kinematic_targets_ = state.kinematic_targets;
+  kinds_changed_ = state.kinds_changed;
+}
+
+void DeformableBody::RestoreSystem(const State& state) {
+  // The saved system was built for the saved kinds: build it the same way (as the saved body's
+  // step did), then put its Newton factor back.
+  const bool rebuild = kinds_changed_ || kinds_ != state.kinds;
+  if (rebuild) system_.Build(*model_, state.kinds);
+  try {
+    system_.RestoreNewtonState(state.newton);
+  } catch (const InputError& error) {
+    kinds_changed_ = kinds_changed_ || rebuild;  // the next step rebuilds for the body's kinds
+    throw InputError(internal::Concat("body '", name(), "': RestoreState: ", error.what()));
+  }
+}
+
 double DeformableBody::CalcKineticEnergy() const {
   double energy = 0.0;
   for (int i = 0; i < num_nodes(); ++i)

@@ -105,6 +105,23 @@ class DeformableBody {
   // external forces dropped), e.g. when another body of the world failed its step.
   void AbortStep();
 
+  // Everything of the body the next step depends on besides its configuration (model, settings):
+  // saved and restored by world snapshots (bullet_bridge/world_snapshot.h). The step's own
+  // intermediates (x0, v0, v*, forces, A and its factor) are recomputed by BeginStep.
+  struct State {
+    VecX x, v;                            // positions [m] and velocities [m/s] (3N)
+    VecX external;                        // forces queued by AddNodeForce [N] (3N)
+    std::vector<NodeKind> kinds;          // free, fixed or kinematic, per node
+    std::vector<Vec3> kinematic_targets;  // per node [m] (used by kinematic nodes)
+    bool kinds_changed = true;            // the system is (re)built at the next BeginStep
+    ImplicitSystem::NewtonState newton;   // the primal solver's Newton factor, reused later
+  };
+  State SaveState() const;
+  // Puts a saved state back, rebuilding the system when the node kinds differ. Between steps
+  // only. Throws InputError naming the body, and changes nothing, when the state is of a body
+  // with another number of nodes or its Newton state does not fit.
+  void RestoreState(const State& state);
+
   // Elastic energy at the current x [J].
   double CalcElasticEnergy() const { return model_->CalcEnergy(x_); }
   // Kinetic energy 1/2 v^T M v [J].
@@ -115,6 +132,8 @@ class DeformableBody {
  private:
   // Throws InputError unless node is in [0, num_nodes()).
   void CheckNode(int node, const char* what) const;
+  // RestoreState's system part: built for the saved kinds, with the saved Newton factor.
+  void RestoreSystem(const State& state);
   // Force-assembly guard: names the node whose external force, or else the element whose elastic
   // force, is not finite.
   void CheckForces();

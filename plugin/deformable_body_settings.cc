@@ -17,6 +17,8 @@ void DeformableBodySettings::Validate() const {
               "': friction must be finite and >= 0, got ", friction);
   TAUT_DEMAND(std::isfinite(contact_margin) && contact_margin > 0.0, "body '", name,
               "': contact margin must be finite and > 0 m, got ", contact_margin);
+  TAUT_DEMAND(restitution >= 0.0 && restitution <= 1.0, "body '", name,
+              "': restitution must be in [0, 1], got ", restitution);
   TAUT_DEMAND(!std::isnan(max_speed) && max_speed > 0.0, "body '", name,
               "': max speed must be > 0 m/s (+inf disables the check), got ", max_speed);
 }

@@ -15,6 +15,14 @@ struct DeformableBodySettings {
   double stiffness_damping = 0.0;  // Rayleigh beta [s], >= 0: damping force -beta K v
   double friction = 0.5;           // Coulomb coefficient >= 0, times the rigid object's friction
   double contact_margin = 0.01;    // [m] > 0: nodes closer than this to a rigid shape get rows
+  // Newton restitution e in [0, 1] of contacts with rigid objects, times the object's
+  // getRestitution() (Bullet's product rule): a contact closing faster than Bullet's
+  // m_restitutionVelocityThreshold [m/s] separates at >= e times its approach speed. Default 0
+  // (no bounce). Contacts between deformables and self-contacts have none.
+  double restitution = 0.0;
+  // Contacts of the body's boundary nodes with its own boundary triangles (docs/math.md §5.5,
+  // self-contact), off by default.
+  bool self_collision = false;
   // [m/s] > 0 (+inf disables): a free node faster than this after the unconstrained solve or at
   // the end of a step counts as an explosion; the step throws SimulationError. Default 1e3 m/s.
   double max_speed = 1e3;

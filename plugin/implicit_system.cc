@@ -207,4 +207,25 @@ double ImplicitSystem::CalcNewtonRefactorCost() const {
   return newton_ldlt_.CalcFactorWork() / iteration;
 }
 
+ImplicitSystem::NewtonState ImplicitSystem::SaveNewtonState() const {
+  NewtonState state;
+  if (use_cholmod_ || !newton_analyzed_) return state;
+  state.analyzed = true;
+  state.H = H_;
+  state.factor = newton_ldlt_;
+  return state;
+}
+
+void ImplicitSystem::RestoreNewtonState(const NewtonState& state) {
+  if (use_cholmod_) return;
+  if (state.analyzed)
+    TAUT_DEMAND(state.H.rows() == num_free_dofs() && state.H.nonZeros() == A_.nonZeros(),
+                "Newton state of ", state.H.rows(), " free DOFs and ", state.H.nonZeros(),
+                " entries does not fit this system (", num_free_dofs(), " free DOFs, ",
+                A_.nonZeros(), " entries)");
+  newton_analyzed_ = state.analyzed;
+  H_ = state.H;
+  newton_ldlt_ = state.factor;
+}
+
 }  // namespace taut

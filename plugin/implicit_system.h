@@ -89,6 +89,20 @@ class ImplicitSystem {
   // is not reused) or before the first factor.
   double CalcNewtonRefactorCost() const;
 
+  // The part of the system that outlives a step: the Newton matrix H and its SparseLdlt factor,
+  // which the primal solver's next steps reuse as a preconditioner (factor reuse). Saved by world
+  // snapshots (bullet_bridge/world_snapshot.h) so a restored body continues bit-identically.
+  // With CHOLMOD nothing is kept (its Newton factor is never reused): `analyzed` stays false.
+  struct NewtonState {
+    bool analyzed = false;  // H's pattern and symbolic analysis are set up
+    Eigen::SparseMatrix<double> H;
+    SparseLdlt factor;
+  };
+  NewtonState SaveNewtonState() const;
+  // Puts a saved state back (CHOLMOD: no-op). The system must be built with the node kinds of the
+  // saved one; throws InputError, changing nothing, when H's size or pattern size differ.
+  void RestoreNewtonState(const NewtonState& state);
+
  private:
   std::vector<int> dof_to_free_;   // (3N) free index or -1
   std::vector<int> free_to_dof_;   // (num_free)

@@ -86,10 +86,11 @@ taut_build_cholmod_tests() {
   cmake --build build/cholmod -j"${TAUT_JOBS}" --target taut_tests
 }
 
-# Debug build (assertions on, -O1 so Eigen-heavy tests finish) with AddressSanitizer and UBSan
-# in build/asan (no benchmarks, no demos).
+# Debug build (assertions on, -O1 so Eigen-heavy tests finish, -g1: line tables for the sanitizers'
+# stack traces, a quarter less compile time than -g) with AddressSanitizer and UBSan in build/asan
+# (no benchmarks, no demos).
 taut_build_asan() {
-  taut_configure_build build/asan -DCMAKE_BUILD_TYPE=Debug "-DCMAKE_CXX_FLAGS_DEBUG=-g -O1" -DTAUT_SANITIZE=ON \
+  taut_configure_build build/asan -DCMAKE_BUILD_TYPE=Debug "-DCMAKE_CXX_FLAGS_DEBUG=-g1 -O1" -DTAUT_SANITIZE=ON \
     -DTAUT_BUILD_BENCH=OFF -DTAUT_BUILD_DEMOS=OFF
 }
 

@@ -107,6 +107,21 @@ TEST(BadInputTest, FrictionMustBeFiniteAndNonNegative) {
   }
 }
 
+TEST(BadInputTest, RestitutionMustLieInZeroToOne) {
+  for (double bad : {-0.1, 1.5, kNan, kInf}) {
+    DeformableBodySettings settings;
+    settings.restitution = bad;
+    ExpectInputError([&] { MakeCube(settings); }, {"body 'cube'", "restitution", "[0, 1]"});
+  }
+  DeformableBodySettings settings;
+  settings.restitution = 1.5;
+  ExpectInputError([&] { MakeCube(settings); }, {"got 1.5"});
+  for (double good : {0.0, 0.5, 1.0}) {
+    settings.restitution = good;
+    EXPECT_NO_THROW(MakeCube(settings));
+  }
+}
+
 TEST(BadInputTest, ContactMarginMustBeFiniteAndPositive) {
   for (double bad : {0.0, -0.01, kNan, kInf}) {
     DeformableBodySettings settings;

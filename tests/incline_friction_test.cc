@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <utility>
 
 #include "bullet_bridge/eigen_bullet.h"
 #include "demos/scenes/bullet_world_holder.h"
@@ -13,7 +14,7 @@ namespace taut {
 namespace {
 
 constexpr double kStep = 1.0 / 240.0;
-constexpr double kMu = 0.5;  // body 0.5 x plane 1.0
+constexpr double kMu = 0.5;  // body 0.5 x plane 1.0 (the product, Bullet's default combiner)
 
 // A 0.1 m soft cube resting on a plane through the origin tilted by theta about y (downhill is
 // +x'), mesh axes aligned with the slope.
@@ -22,16 +23,17 @@ struct BlockOnIncline {
   DeformableBody* block = nullptr;
   Vec3 downhill;
 
-  explicit BlockOnIncline(double theta_deg) {
+  // Body friction body_mu on a plane of friction plane_mu (combined: their product).
+  explicit BlockOnIncline(double theta_deg, double body_mu = kMu, double plane_mu = 1.0) {
     const double theta = theta_deg * M_PI / 180.0;
     const Vec3 normal(std::sin(theta), 0.0, std::cos(theta));
     downhill = Vec3(std::cos(theta), 0.0, -std::sin(theta));
     auto plane = std::make_unique<btStaticPlaneShape>(ToBullet(normal), 0);
-    holder.AddRigidBody(std::move(plane), 0.0, btVector3(0, 0, 0), 1.0);
+    holder.AddRigidBody(std::move(plane), 0.0, btVector3(0, 0, 0), plane_mu);
     DeformableBodySettings settings;
     settings.name = "block";
     settings.material = {1e6, 0.3, 1000.0};
-    settings.friction = kMu;
+    settings.friction = body_mu;
     TetMesh mesh = MakeBoxTetMesh(Vec3(0.1, 0.1, 0.1), 2, 2, 2, Vec3(-0.05, -0.05, 1e-4));
     // Rotate the resting block onto the slope: x -> downhill, z -> normal.
     Mat3 rotation;
@@ -84,6 +86,27 @@ TEST(InclineFrictionTest, SlidingAccelerationMatchesCoulomb) {
   std::printf("35 deg, mu 0.5: a = %.4f m/s^2, Coulomb %.4f m/s^2 (%.2f %%)\n", measured, expected,
               100.0 * (measured / expected - 1.0));
   EXPECT_NEAR(measured, expected, 0.05 * expected);
+}
+
+TEST(InclineFrictionTest, CoefficientIsTheProductOfTheBodysAndTheObjectsFriction) {
+  // mu = settings.friction x btCollisionObject::getFriction(): 1.0 x 0.5 and 0.8 x 0.625 slide
+  // like 0.5 x 1.0 (a = g (sin - 0.5 cos) at 35 deg); 1.0 x 1.0 (mu = 1 > tan 35 deg) sticks.
+  const double theta_deg = 35.0, theta = theta_deg * M_PI / 180.0;
+  const double expected = 9.81 * (std::sin(theta) - 0.5 * std::cos(theta));
+  for (const auto& [body_mu, plane_mu] : {std::pair{1.0, 0.5}, std::pair{0.8, 0.625}}) {
+    BlockOnIncline incline(theta_deg, body_mu, plane_mu);
+    incline.Run(48);
+    const double v0 = incline.CalcSlopeVelocity();
+    incline.Run(72);
+    const double measured = (incline.CalcSlopeVelocity() - v0) / (72 * kStep);
+    std::printf("35 deg, body %.3f x plane %.3f: a = %.4f m/s^2, Coulomb (mu 0.5) %.4f m/s^2\n",
+                body_mu, plane_mu, measured, expected);
+    EXPECT_NEAR(measured, expected, 0.05 * expected);
+  }
+  BlockOnIncline sticking(theta_deg, 1.0, 1.0);
+  const double start = sticking.CalcSlopePosition();
+  sticking.Run(120);
+  EXPECT_LT(std::abs(sticking.CalcSlopePosition() - start), 1e-3);
 }
 
 }  // namespace
