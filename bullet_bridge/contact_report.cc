@@ -103,9 +103,10 @@ void AppendContact(const std::vector<IslandBody*>& bodies, const IslandRows& row
     forces.contacts.push_back(mirror);
     return;
   }
-  // Rigid partner (kRigidContactRowKey).
-  contact.point =
-      static_cast<int>(UnpackRowKeyPayload(kRigidContactRowKey, RowKeyPayload(row.key))[0]);
+  // Rigid partner (kRigidContactRowKey): a contact point, or a face contact on a triangle.
+  const auto fields = UnpackRowKeyPayload(kRigidContactRowKey, RowKeyPayload(row.key));
+  (fields[3] >= kRigidFaceRowOffset ? contact.triangle : contact.point) =
+      static_cast<int>(fields[0]);
   const RigidIslandBody* dynamic = AsRigid(side_b);
   contact.partner_object =
       dynamic != nullptr ? dynamic->rigid() : FindPartnerObject(row.key, objects);

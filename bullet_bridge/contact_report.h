@@ -34,10 +34,12 @@ struct DeformableContactPoint {
   const DeformableBody* body = nullptr;  // the body the impulses act on
   // Index of the contact point in the body's contact surface (a boundary node, or a vertex of
   // the surface given to SetContactSurface); -1 when the contact is another deformable's point on
-  // a surface triangle of this body (then `triangle` says which).
+  // a surface triangle of this body, or a rigid shape's face contact (then `triangle` says which).
   int point = -1;
-  int triangle = -1;  // boundary triangle of this body touched by a partner's point, else -1
-  int node = -1;      // the node when the contact point is a single node, else -1
+  // Boundary triangle of this body touched by a partner's point or by a rigid shape's deepest
+  // point (DeformableBodySettings::face_contact), else -1.
+  int triangle = -1;
+  int node = -1;  // the node when the contact point is a single node, else -1
   // The partner: a rigid object (static, kinematic or dynamic), or another deformable body.
   const btCollisionObject* partner_object = nullptr;
   const DeformableBody* partner_body = nullptr;

@@ -114,6 +114,7 @@ DeformableBody* DeformableWorld::AddDeformableBody(std::unique_ptr<DeformableBod
   entry->contacts = std::make_unique<RigidContactSource>(
       added, entry->surface, next_source_id_++, added.settings().friction,
       added.settings().contact_margin, added.settings().restitution);
+  entry->contacts->set_face_contact(added.settings().face_contact);
   bodies_.push_back(std::move(entry));
   addCollisionObject(&bodies_.back()->collision_object(), btBroadphaseProxy::DefaultFilter,
                      btBroadphaseProxy::AllFilter);

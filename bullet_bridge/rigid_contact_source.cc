@@ -1,11 +1,14 @@
 #include "bullet_bridge/rigid_contact_source.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 #include "bullet_bridge/eigen_bullet.h"
 #include "bullet_bridge/point_shape_distance.h"
+#include "constraints/deformable_contact_source.h"
 #include "plugin/hex_element_model.h"
 #include "plugin/tet_element_model.h"
 
@@ -53,6 +56,12 @@ void RigidContactSource::set_surface(const ContactSurface& surface) {
                   "': contact point node ", p.nodes[k], " out of range [0, ", body_.num_nodes(),
                   ")");
   points_ = surface.points;
+  triangles_ = surface.triangles;
+  node_triangles_ = surface.node_triangles;
+  for (const Triangle& t : triangles_)
+    for (int corner : t)
+      TAUT_DEMAND(corner >= 0 && corner < static_cast<int>(points_.size()), "body '", body_.name(),
+                  "': contact triangle corner ", corner, " out of range [0, ", points_.size(), ")");
 }
 
 void RigidContactSource::set_objects(const std::vector<const btCollisionObject*>& objects) {
@@ -82,10 +91,10 @@ RigidContactSource::PartnerRows RigidContactSource::MakePartnerRows(const Island
   return rows;
 }
 
-void RigidContactSource::FillRow(const PartnerRows& partner, size_t i, const Vec3& d, const Vec3& r,
-                                 int k, ConstraintRow& row) const {
-  const ContactPoint& point = points_[i];
-  row.key = key_.Pack(i, partner.outside_world, partner.object_id, k);
+void RigidContactSource::FillRow(const PartnerRows& partner, const ContactPoint& point,
+                                 std::uint64_t key, const Vec3& d, const Vec3& r, int k,
+                                 ConstraintRow& row) const {
+  row.key = key;
   row.body = partner.body_index;
   row.type = RowType::kContact;
   row.num_nodes = point.num_nodes;
@@ -120,6 +129,29 @@ double RigidContactSource::CalcRestitutionC(const IslandIterate& iterate,
   return std::min(gap, h * (jv - e * approach));
 }
 
+void RigidContactSource::AppendContactRows(const IslandIterate& iterate, const PartnerRows& partner,
+                                           const ContactPoint& point, int index, int row_offset,
+                                           double gap, const Vec3& n, const Vec3& q,
+                                           const Vec3& com,
+                                           std::vector<ConstraintRow>& rows) const {
+  // Normal row C = gap, J = w_k n on the point's nodes; then the two tangents (friction on the
+  // Coulomb disk). A dynamic partner's surface point q moves with v + w x (q - com), so its side
+  // is J_lin = -d, J_ang = -(q - com) x d for each direction d.
+  Vec3 d[3];
+  d[0] = n;
+  CalcContactTangents(n, d[1], d[2]);
+  const size_t normal = rows.size();
+  for (int k = 0; k < 3; ++k) {
+    ConstraintRow& row = rows.emplace_back();
+    const std::uint64_t key =
+        key_.Pack(index, partner.outside_world, partner.object_id, row_offset + k);
+    FillRow(partner, point, key, d[k], q - com, k, row);
+    row.C = k == 0 ? gap : 0.0;
+  }
+  if (partner.restitution > 0.0)
+    rows[normal].C = CalcRestitutionC(iterate, rows[normal], gap, partner.restitution);
+}
+
 int RigidContactSource::AppendIslandRows(const IslandIterate& iterate,
                                          std::vector<ConstraintRow>& rows) {
   const int before = static_cast<int>(rows.size());
@@ -136,24 +168,77 @@ int RigidContactSource::AppendIslandRows(const IslandIterate& iterate,
       const PointContact contact =
           CalcPointShapeDistance(p, *object.getCollisionShape(), transform, margin_);
       if (!contact.valid || contact.gap >= margin_) continue;
-      // Normal row C = gap, J = w_k n on the point's nodes; then the two tangents (friction on
-      // the Coulomb disk). A dynamic partner's surface point q = p - gap n moves with v + w x (q -
-      // com), so its side is J_lin = -d, J_ang = -(q - com) x d for each direction d.
-      Vec3 d[3];
-      d[0] = contact.normal;
-      CalcContactTangents(contact.normal, d[1], d[2]);
-      const Vec3 r = p - contact.gap * contact.normal - com;
-      const size_t normal = rows.size();
-      for (int k = 0; k < 3; ++k) {
-        ConstraintRow& row = rows.emplace_back();
-        FillRow(partner, i, d[k], r, k, row);
-        row.C = k == 0 ? contact.gap : 0.0;
-      }
-      if (partner.restitution > 0.0)
-        rows[normal].C = CalcRestitutionC(iterate, rows[normal], contact.gap, partner.restitution);
+      const Vec3 q = p - contact.gap * contact.normal;  // the partner's surface point
+      AppendContactRows(iterate, partner, point, static_cast<int>(i), 0, contact.gap,
+                        contact.normal, q, com, rows);
     }
+    if (face_contact()) AppendFaceRows(iterate, o, transform, rows);
   }
   return static_cast<int>(rows.size()) - before;
+}
+
+bool RigidContactSource::FindFaceContact(size_t t, const VecX& x, const btCollisionShape& shape,
+                                         const btTransform& transform, FaceContact& contact) const {
+  if (!shape.isConvex()) return false;  // planes, meshes and compounds: points only
+  const Triangle& triangle = triangles_[t];
+  const Vec3 a = CalcContactPointPosition(points_[triangle[0]], x);
+  const Vec3 b = CalcContactPointPosition(points_[triangle[1]], x);
+  const Vec3 c = CalcContactPointPosition(points_[triangle[2]], x);
+  Vec3 n = (b - a).cross(c - a);  // outward (the surface is wound outward)
+  const double norm = n.norm();
+  if (!(norm > 0.0)) return false;
+  n /= norm;
+  // A shape whose centre lies behind the face touches another part of the body.
+  if (n.dot(ToEigen(transform.getOrigin()) - a) <= 0.0) return false;
+  // Deepest point: the support point along -n (Bullet's, with the shape's margin).
+  const auto& convex = static_cast<const btConvexShape&>(shape);
+  const btVector3 local =
+      convex.localGetSupportingVertex(transform.getBasis().transpose() * ToBullet(-n));
+  const Vec3 q = ToEigen(transform(local));
+  const double gap = n.dot(q - a);
+  // Deeper than the triangle is wide: not a contact of this face (the points handle it).
+  const double depth_cap = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm(), margin_});
+  if (gap >= margin_ || gap < -depth_cap) return false;
+  // The point of the triangle nearest to q's projection on its plane (barycentric weights):
+  // inside, the projection; beyond an edge by at most the margin (a point on a shared or creased
+  // edge belongs to both triangles), the nearest edge point.
+  const Vec3 projection = q - gap * n;
+  const Vec3 weights = internal::CalcNearestTrianglePoint(projection, a, b, c);
+  const Vec3 p = weights[0] * a + weights[1] * b + weights[2] * c;
+  if ((projection - p).norm() > margin_) return false;
+  contact.point.num_nodes = 3;
+  for (int k = 0; k < 3; ++k) {
+    contact.point.nodes[k] = points_[triangle[k]].nodes[0];
+    contact.point.weights[k] = weights[k];
+  }
+  contact.gap = gap;
+  contact.normal = -n;
+  contact.q = q;
+  return true;
+}
+
+void RigidContactSource::AppendFaceRows(const IslandIterate& iterate, size_t o,
+                                        const btTransform& transform,
+                                        std::vector<ConstraintRow>& rows) const {
+  const btCollisionShape& shape = *partners_[o].object->getCollisionShape();
+  if (!shape.isConvex()) return;
+  const VecX& x = iterate.x(iterate.IndexOf(&body_));
+  const PartnerRows partner = MakePartnerRows(iterate, o);
+  const Vec3 com = ToEigen(transform.getOrigin());
+  // Only triangles whose bounds meet the shape's bounds grown by the margin.
+  btVector3 lo, hi;
+  shape.getAabb(transform, lo, hi);
+  const Vec3 grow = Vec3::Constant(margin_);
+  const Eigen::AlignedBox3d bounds(ToEigen(lo) - grow, ToEigen(hi) + grow);
+  FaceContact contact;
+  for (size_t t = 0; t < triangles_.size(); ++t) {
+    Eigen::AlignedBox3d box;
+    for (int corner : triangles_[t]) box.extend(CalcContactPointPosition(points_[corner], x));
+    if (!bounds.intersects(box) || !FindFaceContact(t, x, shape, transform, contact)) continue;
+    if (!Moves(contact.point)) continue;
+    AppendContactRows(iterate, partner, contact.point, static_cast<int>(t), kRigidFaceRowOffset,
+                      contact.gap, contact.normal, contact.q, com, rows);
+  }
 }
 
 double RigidContactSource::CalcPointGap(const IslandIterate& iterate, size_t i,
@@ -171,7 +256,8 @@ double RigidContactSource::CalcPointGap(const IslandIterate& iterate, size_t i,
       const PartnerRows partner = MakePartnerRows(iterate, o);
       ConstraintRow normal;
       const Vec3 r = p - contact.gap * contact.normal - ToEigen(transform.getOrigin());
-      FillRow(partner, i, contact.normal, r, 0, normal);
+      const std::uint64_t key = key_.Pack(i, partner.outside_world, partner.object_id, 0);
+      FillRow(partner, points_[i], key, contact.normal, r, 0, normal);
       c = CalcRestitutionC(iterate, normal, contact.gap, e);
     }
     gap = std::min(gap, c);
@@ -185,6 +271,12 @@ double RigidContactSource::CalcIslandViolationSum(const IslandIterate& iterate) 
   for (size_t i = 0; i < points_.size(); ++i)
     if (Moves(points_[i]))
       sum += std::max(0.0, -CalcPointGap(iterate, i, CalcContactPointPosition(points_[i], x)));
+  if (!face_contact()) return sum;
+  // Face contacts: the gaps of the rows AppendFaceRows emits (restitution C included).
+  std::vector<ConstraintRow> faces;
+  for (size_t o = 0; o < partners_.size(); ++o)
+    AppendFaceRows(iterate, o, CalcPartnerTransform(iterate, o), faces);
+  for (const ConstraintRow& row : faces) sum += row.violation();
   return sum;
 }
 

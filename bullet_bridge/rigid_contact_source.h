@@ -34,6 +34,13 @@ class RigidContactSource final : public ConstraintSource {
   // Replaces the contact points (e.g. a surface embedded in a hex body: 8-node rows). Points
   // whose nodes are all fixed or kinematic get no rows.
   void set_surface(const ContactSurface& surface);
+  // Face contact (DeformableBodySettings::face_contact): besides the points, each convex rigid
+  // shape's deepest point below a surface triangle (its support point along the inward normal,
+  // projecting inside the triangle) gets a normal and two friction rows on the triangle's
+  // nodes, with the barycentric weights. Only for surfaces whose triangle corners are single
+  // nodes (ContactSurface::node_triangles); off by default.
+  void set_face_contact(bool on) { face_contact_ = on; }
+  bool face_contact() const { return face_contact_ && node_triangles_; }
 
   const DeformableBody& body() const { return body_; }
   // The partners to test this step (those whose bounds overlap the body's).
@@ -68,10 +75,31 @@ class RigidContactSource final : public ConstraintSource {
   };
   // Partner o's shared row data at the iterate.
   PartnerRows MakePartnerRows(const IslandIterate& iterate, size_t o) const;
-  // The row of direction d (k = 0 normal, 1-2 friction tangents) of point i against a partner
-  // whose surface point is its centre of mass + r.
-  void FillRow(const PartnerRows& partner, size_t i, const Vec3& d, const Vec3& r, int k,
-               ConstraintRow& row) const;
+  // The row of direction d (k = 0 normal, 1-2 friction tangents) of `point` (row key `key`)
+  // against a partner whose surface point is its centre of mass + r.
+  void FillRow(const PartnerRows& partner, const ContactPoint& point, std::uint64_t key,
+               const Vec3& d, const Vec3& r, int k, ConstraintRow& row) const;
+  // The normal and two friction rows of a contact of `point` (gap, unit normal n from the
+  // partner toward the body, partner's surface point q), keyed by `index` and `row_offset`.
+  void AppendContactRows(const IslandIterate& iterate, const PartnerRows& partner,
+                         const ContactPoint& point, int index, int row_offset, double gap,
+                         const Vec3& n, const Vec3& q, const Vec3& com,
+                         std::vector<ConstraintRow>& rows) const;
+  // A convex shape's deepest point below surface triangle t at positions x (docs/math.md §5.5,
+  // face contact).
+  struct FaceContact {
+    ContactPoint point;  // the triangle's nodes with the barycentric weights of the point
+    double gap = 0.0;    // signed distance of the shape's point above the triangle's plane
+    Vec3 normal;         // unit normal from the shape toward the body (the inward face normal)
+    Vec3 q;              // the shape's deepest point
+  };
+  // False when the shape is not convex, lies behind the triangle, is farther than the margin,
+  // or its deepest point projects outside the triangle.
+  bool FindFaceContact(size_t t, const VecX& x, const btCollisionShape& shape,
+                       const btTransform& transform, FaceContact& contact) const;
+  // Face rows of every triangle against partner o (AppendIslandRows' second stage).
+  void AppendFaceRows(const IslandIterate& iterate, size_t o, const btTransform& transform,
+                      std::vector<ConstraintRow>& rows) const;
   // C of a normal row with combined restitution e > 0 (docs/math.md §5.5): when the contact
   // approaches at v* faster than the threshold (approach = -J v*) and would close within the
   // step (gap + h J (v* - v) < 0), C = min(gap, h (J v - e approach)); else the gap.
@@ -85,6 +113,9 @@ class RigidContactSource final : public ConstraintSource {
   double restitution_;
   double restitution_threshold_ = 0.2;  // [m/s], Bullet's default
   std::vector<ContactPoint> points_;
+  std::vector<Triangle> triangles_;  // indices into points_
+  bool node_triangles_ = true;       // every triangle corner is one node
+  bool face_contact_ = false;
   std::vector<ContactPartner> partners_;
 };
 

@@ -48,12 +48,16 @@ inline constexpr RowKeyLayout<4> kDeformableContactRowKey{
 inline constexpr RowKeyLayout<4> kRigidContactRowKey{
     "rigid contact",
     {{
-        {"point", 22},         // contact point of the deformable, < 4,194,304
+        {"point", 22},         // contact point (or, for face rows, triangle), < 4,194,304
         {"outside world", 1},  // 0: object keyed by its world index; 1: an object in no world,
                                //    keyed by its position among the source's partners
-        {"object", 23},        // the world index (getWorldArrayIndex) or position, < 8,388,608
-        {"row", 2},            // 0 normal, 1 and 2 the friction tangents
+        {"object", 22},        // the world index (getWorldArrayIndex) or position, < 4,194,304
+        {"row", 3},            // 0 normal, 1 and 2 the friction tangents; 3-5 the same of a
+                               // face contact (kRigidFaceRowOffset + row)
     }}};
+// "row" field of a face contact's rows (a rigid shape against a boundary triangle): this plus
+// 0 (normal), 1 or 2 (friction tangents).
+inline constexpr int kRigidFaceRowOffset = 3;
 
 // RigidManifoldSource: a point of Bullet's contact manifold between two rigid objects.
 inline constexpr RowKeyLayout<4> kRigidManifoldRowKey{

@@ -23,6 +23,11 @@ struct DeformableBodySettings {
   // Contacts of the body's boundary nodes with its own boundary triangles (docs/math.md §5.5,
   // self-contact), off by default.
   bool self_collision = false;
+  // Contacts of convex rigid shapes with the body's boundary triangles, besides its contact
+  // points: a shape's deepest point below a triangle gets rows on the triangle's 3 nodes (face
+  // contact, docs/math.md §5.5), so a sphere or a capsule edge cannot sink between the nodes.
+  // Off by default; surfaces whose corners are not single nodes (embedded) use points only.
+  bool face_contact = false;
   // [m/s] > 0 (+inf disables): a free node faster than this after the unconstrained solve or at
   // the end of a step counts as an explosion; the step throws SimulationError. Default 1e3 m/s.
   double max_speed = 1e3;

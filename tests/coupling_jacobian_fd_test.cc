@@ -5,6 +5,7 @@
 #include <btBulletDynamicsCommon.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <functional>
 
 #include "bullet_bridge/eigen_bullet.h"
@@ -98,6 +99,61 @@ TEST(CouplingJacobianFdTest, NodeAgainstDynamicRigidBoxMatchesCentralDifferences
   std::printf("node vs dynamic box: %d normal rows, worst relative error %.2e\n", rows, worst);
   EXPECT_GT(rows, 0);
   EXPECT_LT(worst, 1e-6);
+}
+
+TEST(CouplingJacobianFdTest, FaceContactAgainstDynamicShapesMatchesCentralDifferences) {
+  // A sphere 1 cm into the cube's top face, off its nodes, and a tilted box whose lowest corner
+  // is 5 mm into it: face rows (barycentric weights on the triangle's nodes, the shape's deepest
+  // point on the rigid side) besides the node rows within the margin.
+  std::unique_ptr<DeformableBody> cube = MakeCube(Vec3(0.0, 0.0, 0.0), "pad");
+  btSphereShape sphere(0.05);
+  btBoxShape box(btVector3(0.02, 0.03, 0.02));
+  const btTransform poses[] = {
+      btTransform(btQuaternion::getIdentity(), btVector3(0.06, 0.13, 0.24)),
+      btTransform(btQuaternion(btVector3(1, 2, 0).normalized(), 0.5), btVector3(0.12, 0.07, 0.2))};
+  const btCollisionShape* shapes[] = {&sphere, &box};
+  for (int s = 0; s < 2; ++s) {
+    btCollisionShape* shape = const_cast<btCollisionShape*>(shapes[s]);
+    btTransform pose = poses[s];
+    if (s == 1) {
+      // Lower the box until its deepest corner is 5 mm below the face z = 0.2.
+      btVector3 lo, hi;
+      shape->getAabb(pose, lo, hi);
+      pose.getOrigin().setZ(pose.getOrigin().z() + 0.195 - lo.z());
+    }
+    btDefaultMotionState state(pose);
+    btVector3 inertia;
+    shape->calculateLocalInertia(1.0, inertia);
+    btRigidBody rigid(1.0, &state, shape, inertia);
+    RigidIslandBody body(&rigid);
+    body.BeginStep(kH);
+    // Margin 3 cm: the deepest point projects more than that from the other top triangle, so
+    // every face row is interior (edge rows, within the margin beyond a triangle's edge, keep
+    // the weights of the nearest edge point: exact only to first order in that offset).
+    RigidContactSource source(*cube, MakeBodyContactSurface(cube->model()), 1, 0.5, 0.03);
+    source.set_face_contact(true);
+    source.set_partners({{&rigid, &body}});
+    DeformableIslandBody flesh(*cube);
+    VecX v_rigid(6);
+    v_rigid << 0.1, -0.2, 0.3, 0.0, 0.0, 0.0;
+    VecX v_flesh(3 * cube->num_nodes());
+    for (int i = 0; i < cube->num_nodes(); ++i)
+      v_flesh.segment<3>(3 * i) = Vec3(0.02 * i, -0.01 * i, 0.05 - 0.01 * i);
+    std::vector<ConstraintRow> rows;
+    std::vector<VecX> x(2);
+    const std::vector<IslandBody*> bodies = {&flesh, &body};
+    for (size_t b = 0; b < 2; ++b) bodies[b]->CalcPositions(kH, b == 0 ? v_flesh : v_rigid, x[b]);
+    source.AppendIslandRows(IslandIterate(kH, bodies, {v_flesh, v_rigid}, x), rows);
+    const long faces = std::count_if(rows.begin(), rows.end(), [](const ConstraintRow& row) {
+      return row.friction_of == 0 && row.num_nodes == 3;
+    });
+    int checked = 0;
+    const double worst = CheckRows(bodies, {v_flesh, v_rigid}, source, &checked);
+    std::printf("face contact, %s: %ld face rows of %d normal rows, worst relative error %.2e\n",
+                s == 0 ? "sphere" : "box", faces, checked, worst);
+    EXPECT_GE(faces, 1);
+    EXPECT_LT(worst, 1e-6);
+  }
 }
 
 TEST(CouplingJacobianFdTest, AttachmentRowsMatchCentralDifferences) {

@@ -237,10 +237,10 @@ TEST(RowKeyTest, RigidObjectsWhoseWorldIndicesDifferBy4096Or65536GetDifferentKey
     ASSERT_GE(rows.size(), 2u * 4 * 3) << "every bottom point touches both boxes";
     EXPECT_EQ(CountRepeatedKeys(rows), 0) << "world indices " << near_index << ", " << far_index;
   }
-  // An index beyond the object field's 23 bits is reported, not wrapped.
-  far.setWorldArrayIndex(1 << 23);
+  // An index beyond the object field's 22 bits is reported, not wrapped.
+  far.setWorldArrayIndex(1 << 22);
   ExpectInputError([&] { CollectRows(source, {&body}); },
-                   {"rigid contact", "object " + std::to_string(1 << 23), "23-bit"});
+                   {"rigid contact", "object " + std::to_string(1 << 22), "22-bit"});
 }
 
 // Manifolds between objects whose broadphase ids differ by 2^20 (the old layout kept 20 bits).

@@ -1,0 +1,81 @@
+// Face contact of rigid shapes with a deformable's boundary triangles
+// (DeformableBodySettings::face_contact, docs/math.md §5.5): a ball smaller than the block's
+// surface cells, dropped between its nodes, falls through a body that touches rigid shapes at
+// its nodes only, and rests on its surface with face contact, carried by the face rows.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "demos/scenes/bullet_world_holder.h"
+#include "plugin/box_tet_mesher.h"
+
+namespace taut {
+namespace {
+
+constexpr double kStep = 1.0 / 240.0;
+constexpr double kRadius = 0.05;  // [m], less than the 0.14 m from a cell centre to its nodes
+constexpr double kTop = 0.1;      // [m] the block's top face
+constexpr double kMass = 1.0;     // [kg]
+
+struct BallOnBlock {
+  BulletWorldHolder holder;
+  DeformableBody* block = nullptr;
+  btRigidBody* ball = nullptr;
+};
+
+// A 1 kg ball released 2 cm above the centre of a top cell of a stiff 0.4 x 0.4 x 0.1 m block
+// (E = 10 MPa, 2 x 2 x 1 cells of 0.2 m, bottom clamped), stepped for `steps` steps.
+void DropBetweenNodes(bool face_contact, int steps, BallOnBlock& scene) {
+  DeformableBodySettings settings;
+  settings.name = "block";
+  settings.material = {1e7, 0.3, 1000.0};
+  settings.face_contact = face_contact;
+  scene.block = scene.holder.world.AddTetBody(
+      MakeBoxTetMesh(Vec3(0.4, 0.4, kTop), 2, 2, 1, Vec3(-0.2, -0.2, 0.0)), settings);
+  scene.block->FixNodesWhere([](const Vec3& X) { return X.z() < 1e-9; });
+  scene.ball = scene.holder.AddRigidBody(std::make_unique<btSphereShape>(kRadius), kMass,
+                                         btVector3(0.1, 0.1, kTop + kRadius + 0.02), 0.5, 0.0);
+  for (int i = 0; i < steps; ++i) scene.holder.world.stepSimulation(kStep, 1, kStep);
+}
+
+double BallBottom(const BallOnBlock& scene) {
+  return static_cast<double>(scene.ball->getCenterOfMassPosition().z()) - kRadius;
+}
+
+TEST(FaceContactTest, IsOffByDefault) { EXPECT_FALSE(DeformableBodySettings().face_contact); }
+
+TEST(FaceContactTest, BallBetweenTheNodesFallsThroughWithoutFaceContact) {
+  BallOnBlock scene;
+  DropBetweenNodes(false, 120, scene);
+  std::printf("without face contact: ball bottom %.4f m after 0.5 s (top face %.2f m)\n",
+              BallBottom(scene), kTop);
+  EXPECT_LT(BallBottom(scene), 0.0) << "no node is within reach of the ball";
+}
+
+TEST(FaceContactTest, BallBetweenTheNodesRestsOnTheFaceAndItsWeightIsReported) {
+  BallOnBlock scene;
+  DropBetweenNodes(true, 240, scene);
+  const double bottom = BallBottom(scene);
+  const double vz = static_cast<double>(scene.ball->getLinearVelocity().z());
+  // The face rows carry the weight: the normal forces of the contacts on triangles, summed.
+  const SubstepForces& forces = scene.holder.world.last_substep_forces();
+  double face_force = 0.0, node_force = 0.0;
+  for (const DeformableContactPoint& contact : forces.contacts)
+    (contact.triangle >= 0 ? face_force : node_force) += contact.force.z();
+  const double weight = kMass * 9.81;
+  std::printf(
+      "with face contact: ball bottom %.5f m (top face %.2f m), v_z %.2e m/s, face force "
+      "%.4f N, node force %.4f N, weight %.4f N\n",
+      bottom, kTop, vz, face_force, node_force, weight);
+  // On the surface: the stiff block gives way by well under a millimetre under 9.8 N, and the
+  // contact tolerance is 1e-5 m.
+  EXPECT_GT(bottom, kTop - 1e-3);
+  EXPECT_LT(bottom, kTop + 1e-4);
+  EXPECT_LT(std::abs(vz), 1e-2);
+  EXPECT_EQ(node_force, 0.0) << "no node is within reach of the ball";
+  // The ball pushes the block down (force on the block along -z) by its weight.
+  EXPECT_NEAR(-face_force / weight, 1.0, 0.005);
+}
+
+}  // namespace
+}  // namespace taut
