@@ -1,5 +1,8 @@
 #include "bullet_bridge/rigid_contact_source.h"
 
+#include <BulletCollision/CollisionShapes/btTriangleShape.h>
+#include <BulletCollision/NarrowPhaseCollision/btGjkEpa2.h>
+
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -180,40 +183,41 @@ int RigidContactSource::AppendIslandRows(const IslandIterate& iterate,
 bool RigidContactSource::FindFaceContact(size_t t, const VecX& x, const btCollisionShape& shape,
                                          const btTransform& transform, FaceContact& contact) const {
   if (!shape.isConvex()) return false;  // planes, meshes and compounds: points only
-  const Triangle& triangle = triangles_[t];
-  const Vec3 a = CalcContactPointPosition(points_[triangle[0]], x);
-  const Vec3 b = CalcContactPointPosition(points_[triangle[1]], x);
-  const Vec3 c = CalcContactPointPosition(points_[triangle[2]], x);
+  const Triangle& corners = triangles_[t];
+  const Vec3 a = CalcContactPointPosition(points_[corners[0]], x);
+  const Vec3 b = CalcContactPointPosition(points_[corners[1]], x);
+  const Vec3 c = CalcContactPointPosition(points_[corners[2]], x);
   Vec3 n = (b - a).cross(c - a);  // outward (the surface is wound outward)
   const double norm = n.norm();
   if (!(norm > 0.0)) return false;
   n /= norm;
   // A shape whose centre lies behind the face touches another part of the body.
   if (n.dot(ToEigen(transform.getOrigin()) - a) <= 0.0) return false;
-  // Deepest point: the support point along -n (Bullet's, with the shape's margin).
+  // Closest points of the triangle and the shape's core (Bullet's GJK; the shape is its core
+  // grown by its collision margin, e.g. a capsule's segment by its radius).
   const auto& convex = static_cast<const btConvexShape&>(shape);
-  const btVector3 local =
-      convex.localGetSupportingVertex(transform.getBasis().transpose() * ToBullet(-n));
-  const Vec3 q = ToEigen(transform(local));
-  const double gap = n.dot(q - a);
-  // Deeper than the triangle is wide: not a contact of this face (the points handle it).
-  const double depth_cap = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm(), margin_});
-  if (gap >= margin_ || gap < -depth_cap) return false;
-  // The point of the triangle nearest to q's projection on its plane (barycentric weights):
-  // inside, the projection; beyond an edge by at most the margin (a point on a shared or creased
-  // edge belongs to both triangles), the nearest edge point.
-  const Vec3 projection = q - gap * n;
-  const Vec3 weights = internal::CalcNearestTrianglePoint(projection, a, b, c);
-  const Vec3 p = weights[0] * a + weights[1] * b + weights[2] * c;
-  if ((projection - p).norm() > margin_) return false;
+  btTriangleShape triangle(ToBullet(a), ToBullet(b), ToBullet(c));
+  triangle.setMargin(0);
+  btGjkEpaSolver2::sResults result;
+  if (!btGjkEpaSolver2::Distance(&triangle, btTransform::getIdentity(), &convex, transform,
+                                 ToBullet(n), result))
+    return false;  // the core reaches the triangle: deeper than the margin, points only
+  const double core_distance = result.distance;
+  const Vec3 normal = ToEigen(result.normal);  // unit, from the shape's core to the triangle
+  // Only a shape outside the face pushes it inward.
+  if (!(core_distance > 0.0) || normal.dot(n) >= 0.0) return false;
+  const double shape_margin = convex.getMargin();
+  contact.gap = core_distance - shape_margin;
+  if (contact.gap >= margin_) return false;
+  const Vec3 p = ToEigen(result.witnesses[0]);  // on the triangle
+  const Vec3 weights = internal::CalcNearestTrianglePoint(p, a, b, c);
   contact.point.num_nodes = 3;
   for (int k = 0; k < 3; ++k) {
-    contact.point.nodes[k] = points_[triangle[k]].nodes[0];
+    contact.point.nodes[k] = points_[corners[k]].nodes[0];
     contact.point.weights[k] = weights[k];
   }
-  contact.gap = gap;
-  contact.normal = -n;
-  contact.q = q;
+  contact.normal = normal;
+  contact.q = ToEigen(result.witnesses[1]) + shape_margin * normal;  // on the shape's surface
   return true;
 }
 

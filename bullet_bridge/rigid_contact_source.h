@@ -34,11 +34,10 @@ class RigidContactSource final : public ConstraintSource {
   // Replaces the contact points (e.g. a surface embedded in a hex body: 8-node rows). Points
   // whose nodes are all fixed or kinematic get no rows.
   void set_surface(const ContactSurface& surface);
-  // Face contact (DeformableBodySettings::face_contact): besides the points, each convex rigid
-  // shape's deepest point below a surface triangle (its support point along the inward normal,
-  // projecting inside the triangle) gets a normal and two friction rows on the triangle's
-  // nodes, with the barycentric weights. Only for surfaces whose triangle corners are single
-  // nodes (ContactSurface::node_triangles); off by default.
+  // Face contact (DeformableBodySettings::face_contact): besides the points, each surface
+  // triangle within the margin of a convex rigid shape gets a normal and two friction rows at
+  // their closest points, on the triangle's nodes with the barycentric weights. Only for surfaces
+  // whose triangle corners are single nodes (ContactSurface::node_triangles); off by default.
   void set_face_contact(bool on) { face_contact_ = on; }
   bool face_contact() const { return face_contact_ && node_triangles_; }
 
@@ -85,16 +84,16 @@ class RigidContactSource final : public ConstraintSource {
                          const ContactPoint& point, int index, int row_offset, double gap,
                          const Vec3& n, const Vec3& q, const Vec3& com,
                          std::vector<ConstraintRow>& rows) const;
-  // A convex shape's deepest point below surface triangle t at positions x (docs/math.md §5.5,
-  // face contact).
+  // The closest points of surface triangle t at positions x and a convex shape, when the shape
+  // is outside the face within the margin (docs/math.md §5.5, face contact).
   struct FaceContact {
-    ContactPoint point;  // the triangle's nodes with the barycentric weights of the point
-    double gap = 0.0;    // signed distance of the shape's point above the triangle's plane
-    Vec3 normal;         // unit normal from the shape toward the body (the inward face normal)
-    Vec3 q;              // the shape's deepest point
+    ContactPoint point;  // the triangle's nodes with the barycentric weights of its closest point
+    double gap = 0.0;    // distance from the triangle to the shape's surface (< 0: penetration)
+    Vec3 normal;         // unit normal from the shape toward the triangle
+    Vec3 q;              // the shape's closest point
   };
   // False when the shape is not convex, lies behind the triangle, is farther than the margin,
-  // or its deepest point projects outside the triangle.
+  // or is deeper into the triangle than its own collision margin.
   bool FindFaceContact(size_t t, const VecX& x, const btCollisionShape& shape,
                        const btTransform& transform, FaceContact& contact) const;
   // Face rows of every triangle against partner o (AppendIslandRows' second stage).

@@ -108,6 +108,7 @@ TEST(CouplingJacobianFdTest, FaceContactAgainstDynamicShapesMatchesCentralDiffer
   std::unique_ptr<DeformableBody> cube = MakeCube(Vec3(0.0, 0.0, 0.0), "pad");
   btSphereShape sphere(0.05);
   btBoxShape box(btVector3(0.02, 0.03, 0.02));
+  box.setMargin(0.005);  // below the half extents (Bullet's default 4 cm would invert the core)
   const btTransform poses[] = {
       btTransform(btQuaternion::getIdentity(), btVector3(0.06, 0.13, 0.24)),
       btTransform(btQuaternion(btVector3(1, 2, 0).normalized(), 0.5), btVector3(0.12, 0.07, 0.2))};
@@ -127,9 +128,8 @@ TEST(CouplingJacobianFdTest, FaceContactAgainstDynamicShapesMatchesCentralDiffer
     btRigidBody rigid(1.0, &state, shape, inertia);
     RigidIslandBody body(&rigid);
     body.BeginStep(kH);
-    // Margin 3 cm: the deepest point projects more than that from the other top triangle, so
-    // every face row is interior (edge rows, within the margin beyond a triangle's edge, keep
-    // the weights of the nearest edge point: exact only to first order in that offset).
+    // Margin 3 cm: the closest points lie inside one top triangle, farther than that from the
+    // other.
     RigidContactSource source(*cube, MakeBodyContactSurface(cube->model()), 1, 0.5, 0.03);
     source.set_face_contact(true);
     source.set_partners({{&rigid, &body}});

@@ -1,9 +1,11 @@
 // Face contact of rigid shapes with a deformable's boundary triangles
 // (DeformableBodySettings::face_contact, docs/math.md §5.5): a ball smaller than the block's
 // surface cells, dropped between its nodes, falls through a body that touches rigid shapes at
-// its nodes only, and rests on its surface with face contact, carried by the face rows.
+// its nodes only, and rests on its surface with face contact, carried by the face rows; a thin
+// capsule rolled over a soft slab stays on its surface.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "demos/scenes/bullet_world_holder.h"
@@ -75,6 +77,74 @@ TEST(FaceContactTest, BallBetweenTheNodesRestsOnTheFaceAndItsWeightIsReported) {
   EXPECT_EQ(node_force, 0.0) << "no node is within reach of the ball";
   // The ball pushes the block down (force on the block along -z) by its weight.
   EXPECT_NEAR(-face_force / weight, 1.0, 0.005);
+}
+
+struct CapsuleRoll {
+  double deepest_gap = 0.0;    // [m] most negative contact gap of the capsule after landing
+  double highest_gap = -1.0;   // [m] largest per-step smallest gap (how far it floated)
+  double lowest_bottom = 1e9;  // [m] lowest point of the capsule over the run
+  double travel = 0.0;         // [m] distance rolled along x
+  int steps_without_contact = 0;
+};
+
+// A 0.25 kg capsule of radius 2 cm (below the 0.1 m node spacing) lying across a soft slab
+// (E = 200 kPa, 0.6 x 0.3 x 0.05 m, 6 x 3 x 1 cells, bottom clamped) between two rows of nodes,
+// rolled along x at 0.2 m/s for 1 s: its contact gaps each step once it has landed (0.1 s).
+CapsuleRoll RollCapsule(bool face_contact) {
+  BulletWorldHolder holder;
+  DeformableBodySettings settings;
+  settings.name = "slab";
+  settings.material = {2e5, 0.3, 1000.0};
+  settings.friction = 1.0;
+  settings.face_contact = face_contact;
+  DeformableBody* slab = holder.world.AddTetBody(
+      MakeBoxTetMesh(Vec3(0.6, 0.3, 0.05), 6, 3, 1, Vec3(0.0, 0.0, 0.0)), settings);
+  slab->FixNodesWhere([](const Vec3& X) { return X.z() < 1e-9; });
+  constexpr double kCapsuleRadius = 0.02;
+  btRigidBody* capsule =
+      holder.AddRigidBody(std::make_unique<btCapsuleShape>(kCapsuleRadius, 0.16), 0.25,
+                          btVector3(0.15, 0.15, 0.05 + kCapsuleRadius), 1.0, 0.0);
+  capsule->setActivationState(DISABLE_DEACTIVATION);
+  capsule->setLinearVelocity(btVector3(0.2, 0, 0));
+  capsule->setAngularVelocity(btVector3(0, 0.2 / kCapsuleRadius, 0));  // rolling: v = w r
+  const double x0 = static_cast<double>(capsule->getCenterOfMassPosition().x());
+  CapsuleRoll roll;
+  for (int i = 0; i < 240; ++i) {
+    holder.world.stepSimulation(kStep, 1, kStep);
+    const double bottom =
+        static_cast<double>(capsule->getCenterOfMassPosition().z()) - kCapsuleRadius;
+    roll.lowest_bottom = std::min(roll.lowest_bottom, bottom);
+    if (i < 24) continue;
+    double smallest = 1e9;
+    for (const DeformableContactPoint& contact : holder.world.last_contacts(slab))
+      if (contact.partner_object == capsule) smallest = std::min(smallest, contact.gap);
+    if (smallest > 1e8) {
+      ++roll.steps_without_contact;
+      continue;
+    }
+    roll.deepest_gap = std::min(roll.deepest_gap, smallest);
+    roll.highest_gap = std::max(roll.highest_gap, smallest);
+  }
+  roll.travel = static_cast<double>(capsule->getCenterOfMassPosition().x()) - x0;
+  return roll;
+}
+
+TEST(FaceContactTest, CapsuleRolledOverASoftSlabStaysWithinHalfAMillimetreOfItsSurface) {
+  const CapsuleRoll faces = RollCapsule(true);
+  std::printf(
+      "face contact: lowest %.4f deepest gap %.2e m, largest smallest gap %.2e m, %d steps without "
+      "contact, rolled %.3f m\n",
+      faces.lowest_bottom, faces.deepest_gap, faces.highest_gap, faces.steps_without_contact,
+      faces.travel);
+  EXPECT_GT(faces.deepest_gap, -5e-4);
+  EXPECT_LT(faces.highest_gap, 5e-4);
+  EXPECT_EQ(faces.steps_without_contact, 0);
+  EXPECT_GT(faces.travel, 0.1) << "it rolls over at least one cell";
+  // Point contact only: the capsule lies between the nodes and sinks into the slab.
+  const CapsuleRoll points = RollCapsule(false);
+  std::printf("point contact: lowest capsule point %.4f m (slab top 0.05 m)\n",
+              points.lowest_bottom);
+  EXPECT_LT(points.lowest_bottom, 0.05 - 5e-3);
 }
 
 }  // namespace
