@@ -60,7 +60,6 @@ void RigidContactSource::set_surface(const ContactSurface& surface) {
                   ")");
   points_ = surface.points;
   triangles_ = surface.triangles;
-  node_triangles_ = surface.node_triangles;
   for (const Triangle& t : triangles_)
     for (int corner : t)
       TAUT_DEMAND(corner >= 0 && corner < static_cast<int>(points_.size()), "body '", body_.name(),
@@ -180,6 +179,30 @@ int RigidContactSource::AppendIslandRows(const IslandIterate& iterate,
   return static_cast<int>(rows.size()) - before;
 }
 
+bool RigidContactSource::CombineCornerPoints(const Triangle& corners, const Vec3& beta,
+                                             ContactPoint& point) const {
+  // sum_k beta_k sum_n w_kn x_kn with equal nodes merged (corners of an embedded surface share
+  // their element's nodes).
+  point.num_nodes = 0;
+  for (int k = 0; k < 3; ++k) {
+    const ContactPoint& corner = points_[corners[k]];
+    for (int j = 0; j < corner.num_nodes; ++j) {
+      const double w = beta[k] * corner.weights[j];
+      if (w == 0.0) continue;
+      int n = 0;
+      while (n < point.num_nodes && point.nodes[n] != corner.nodes[j]) ++n;
+      if (n == point.num_nodes) {
+        if (n == static_cast<int>(point.nodes.size())) return false;  // too many nodes
+        point.nodes[n] = corner.nodes[j];
+        point.weights[n] = 0.0;
+        ++point.num_nodes;
+      }
+      point.weights[n] += w;
+    }
+  }
+  return true;
+}
+
 bool RigidContactSource::FindFaceContact(size_t t, const VecX& x, const btCollisionShape& shape,
                                          const btTransform& transform, FaceContact& contact) const {
   if (!shape.isConvex()) return false;  // planes, meshes and compounds: points only
@@ -211,11 +234,7 @@ bool RigidContactSource::FindFaceContact(size_t t, const VecX& x, const btCollis
   if (contact.gap >= margin_) return false;
   const Vec3 p = ToEigen(result.witnesses[0]);  // on the triangle
   const Vec3 weights = internal::CalcNearestTrianglePoint(p, a, b, c);
-  contact.point.num_nodes = 3;
-  for (int k = 0; k < 3; ++k) {
-    contact.point.nodes[k] = points_[corners[k]].nodes[0];
-    contact.point.weights[k] = weights[k];
-  }
+  if (!CombineCornerPoints(corners, weights, contact.point)) return false;
   contact.normal = normal;
   contact.q = ToEigen(result.witnesses[1]) + shape_margin * normal;  // on the shape's surface
   return true;

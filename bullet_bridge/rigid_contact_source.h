@@ -36,10 +36,11 @@ class RigidContactSource final : public ConstraintSource {
   void set_surface(const ContactSurface& surface);
   // Face contact (DeformableBodySettings::face_contact): besides the points, each surface
   // triangle within the margin of a convex rigid shape gets a normal and two friction rows at
-  // their closest points, on the triangle's nodes with the barycentric weights. Only for surfaces
-  // whose triangle corners are single nodes (ContactSurface::node_triangles); off by default.
+  // their closest points, on the triangle's nodes with the barycentric weights (corners of an
+  // embedded surface: their elements' nodes, merged; a triangle whose corners span more than 8
+  // nodes keeps point contact). Off by default.
   void set_face_contact(bool on) { face_contact_ = on; }
-  bool face_contact() const { return face_contact_ && node_triangles_; }
+  bool face_contact() const { return face_contact_; }
 
   const DeformableBody& body() const { return body_; }
   // The partners to test this step (those whose bounds overlap the body's).
@@ -96,6 +97,9 @@ class RigidContactSource final : public ConstraintSource {
   // or is deeper into the triangle than its own collision margin.
   bool FindFaceContact(size_t t, const VecX& x, const btCollisionShape& shape,
                        const btTransform& transform, FaceContact& contact) const;
+  // point = sum_k beta_k (corner k's point) over the triangle's corners, equal nodes merged;
+  // false when that spans more nodes than a contact point holds (8).
+  bool CombineCornerPoints(const Triangle& corners, const Vec3& beta, ContactPoint& point) const;
   // Face rows of every triangle against partner o (AppendIslandRows' second stage).
   void AppendFaceRows(const IslandIterate& iterate, size_t o, const btTransform& transform,
                       std::vector<ConstraintRow>& rows) const;
@@ -113,7 +117,6 @@ class RigidContactSource final : public ConstraintSource {
   double restitution_threshold_ = 0.2;  // [m/s], Bullet's default
   std::vector<ContactPoint> points_;
   std::vector<Triangle> triangles_;  // indices into points_
-  bool node_triangles_ = true;       // every triangle corner is one node
   bool face_contact_ = false;
   std::vector<ContactPartner> partners_;
 };

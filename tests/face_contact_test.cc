@@ -10,6 +10,7 @@
 
 #include "demos/scenes/bullet_world_holder.h"
 #include "plugin/box_tet_mesher.h"
+#include "plugin/surface_mesh.h"
 
 namespace taut {
 namespace {
@@ -77,6 +78,43 @@ TEST(FaceContactTest, BallBetweenTheNodesRestsOnTheFaceAndItsWeightIsReported) {
   EXPECT_EQ(node_force, 0.0) << "no node is within reach of the ball";
   // The ball pushes the block down (force on the block along -z) by its weight.
   EXPECT_NEAR(-face_force / weight, 1.0, 0.005);
+}
+
+TEST(FaceContactTest, BallRestsOnTheTrianglesOfAnEmbeddedContactSurface) {
+  // A one-cell tet block (0.4 x 0.4 x 0.1 m, 8 nodes) whose contact surface is its own box
+  // surface inset by 1 mm, two triangles per face: the embedded corners are 0.28 m from the
+  // ball's centre, so only the triangles (4-node corner points, merged onto the 8 nodes) hold it.
+  for (bool face_contact : {false, true}) {
+    BulletWorldHolder holder;
+    DeformableBodySettings settings;
+    settings.name = "block";
+    settings.material = {1e7, 0.3, 1000.0};
+    settings.face_contact = face_contact;
+    DeformableBody* block = holder.world.AddTetBody(
+        MakeBoxTetMesh(Vec3(0.4, 0.4, kTop), 1, 1, 1, Vec3(-0.2, -0.2, 0.0)), settings);
+    block->FixNodesWhere([](const Vec3& X) { return X.z() < 1e-9; });
+    constexpr double kInset = 1e-3;
+    holder.world.SetContactSurface(
+        block, MakeBoxSurface(Vec3(0.4 - 2 * kInset, 0.4 - 2 * kInset, kTop - 2 * kInset), 1, 1, 1,
+                              Vec3(-0.2 + kInset, -0.2 + kInset, kInset)));
+    btRigidBody* ball = holder.AddRigidBody(std::make_unique<btSphereShape>(kRadius), kMass,
+                                            btVector3(0.03, -0.04, kTop + kRadius), 0.5, 0.0);
+    for (int i = 0; i < 240; ++i) holder.world.stepSimulation(kStep, 1, kStep);
+    const double bottom = static_cast<double>(ball->getCenterOfMassPosition().z()) - kRadius;
+    double face_force = 0.0;
+    for (const DeformableContactPoint& contact : holder.world.last_contacts(block))
+      if (contact.triangle >= 0) face_force += contact.force.z();
+    std::printf(
+        "embedded surface, face contact %s: ball bottom %.5f m (surface %.3f m), face "
+        "force %.4f N\n",
+        face_contact ? "on" : "off", bottom, kTop - kInset, face_force);
+    if (!face_contact) {
+      EXPECT_LT(bottom, 0.0) << "the embedded vertices are out of the ball's reach";
+      continue;
+    }
+    EXPECT_NEAR(bottom, kTop - kInset, 1e-4);
+    EXPECT_NEAR(-face_force / (kMass * 9.81), 1.0, 0.005);
+  }
 }
 
 struct CapsuleRoll {
