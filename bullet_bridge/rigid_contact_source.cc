@@ -296,10 +296,10 @@ double RigidContactSource::CalcIslandViolationSum(const IslandIterate& iterate) 
       sum += std::max(0.0, -CalcPointGap(iterate, i, CalcContactPointPosition(points_[i], x)));
   if (!face_contact()) return sum;
   // Face contacts: the gaps of the rows AppendFaceRows emits (restitution C included).
-  std::vector<ConstraintRow> faces;
+  face_rows_.clear();
   for (size_t o = 0; o < partners_.size(); ++o)
-    AppendFaceRows(iterate, o, CalcPartnerTransform(iterate, o), faces);
-  for (const ConstraintRow& row : faces) sum += row.violation();
+    AppendFaceRows(iterate, o, CalcPartnerTransform(iterate, o), face_rows_);
+  for (const ConstraintRow& row : face_rows_) sum += row.violation();
   return sum;
 }
 

@@ -116,7 +116,8 @@ class RigidContactSource final : public ConstraintSource {
   double restitution_;
   double restitution_threshold_ = 0.2;  // [m/s], Bullet's default
   std::vector<ContactPoint> points_;
-  std::vector<Triangle> triangles_;  // indices into points_
+  std::vector<Triangle> triangles_;               // indices into points_
+  mutable std::vector<ConstraintRow> face_rows_;  // CalcIslandViolationSum's face rows (reused)
   bool face_contact_ = false;
   std::vector<ContactPartner> partners_;
 };
