@@ -21,6 +21,12 @@ bool IsCertified(const KktResiduals& kkt, double violation_tolerance,
          kkt.stationarity <= stationarity_tolerance;
 }
 
+double CalcCertificateResidual(const KktResiduals& kkt, double violation_tolerance,
+                               double stationarity_tolerance) {
+  return std::max(std::max(kkt.max_primal(), kkt.max_complementarity()) / violation_tolerance,
+                  kkt.stationarity / stationarity_tolerance);
+}
+
 void RecordKkt(const KktResiduals& kkt, StepStats& stats) {
   stats.stationarity = kkt.stationarity;
   stats.kkt_primal = kkt.max_primal();

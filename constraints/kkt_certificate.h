@@ -37,6 +37,12 @@ KktResiduals CalcKktResiduals(const std::vector<IslandBody*>& bodies, const Isla
                               const VecX& lambda, const std::vector<VecX>& v, double h,
                               double distance_scale, VecX& scratch);
 
+// The certificate's residual as one number: the larger of max(primal, complementarity) over the
+// violation tolerance and the stationarity over its tolerance (<= 1: primal, complementarity and
+// stationarity certified).
+double CalcCertificateResidual(const KktResiduals& kkt, double violation_tolerance,
+                               double stationarity_tolerance);
+
 // True when every residual is within tolerance: primal and complementarity <= violation_tolerance
 // (C units), dual <= 1e-6, stationarity <= stationarity_tolerance.
 bool IsCertified(const KktResiduals& kkt, double violation_tolerance,

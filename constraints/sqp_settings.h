@@ -55,9 +55,16 @@ struct SqpSettings {
   double stationarity_tolerance = 1e-2;  // ... and the relative stationarity (kkt_certificate.h)
   int max_restoration_iterations = 10;   // push-only iterations after the cap while infeasible
   int max_line_search_halvings = 8;      // merit backtracking: alpha = 1, 1/2, ...
-  double stalled_step = 0.1;             // feasible and last alpha below this: stop (stalled)
-  PgsSettings pgs = DefaultPgs();        // sweeps and tolerance of each QP
-  bool polish_active_set = true;         // refine an unconverged PGS answer by active-set solves
+  // Dual path (docs/math.md §5.7, certificate steps): a full QP step that the merit rejects is
+  // still taken when it lowers the certificate's residual (CalcCertificateResidual at its own
+  // rows) by 10 % and leaves no row violated by more than full_step_violation_factor x the
+  // tolerance (or than now); and the SQP stops once the step is certified, not when it is only
+  // feasible and stationary. Off: the merit alone decides, and feasible and stationary stops.
+  bool certificate_steps = true;
+  double full_step_violation_factor = 10.0;
+  double stalled_step = 0.1;       // feasible and last alpha below this: stop (stalled)
+  PgsSettings pgs = DefaultPgs();  // sweeps and tolerance of each QP
+  bool polish_active_set = true;   // refine an unconverged PGS answer by active-set solves
   ActiveSetPolishSettings polish;
   bool warm_start = true;  // warm-start lambda from the previous step by row key
   // Which island solver runs (constraints/island_solver.h) and the primal path's settings.

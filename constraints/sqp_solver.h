@@ -8,6 +8,7 @@
 #include "constraints/constraint_row.h"
 #include "constraints/island_body.h"
 #include "constraints/island_rows.h"
+#include "constraints/kkt_certificate.h"
 #include "constraints/pgs_solver.h"
 #include "constraints/sqp_settings.h"
 #include "constraints/step_stats.h"
@@ -54,6 +55,17 @@ class SqpSolver {
                    double rho);
   // PGS row descriptions of rows_ (unilateral, or friction on the disk of its normal row).
   void BuildPgsRows();
+  // The certificate of the full QP step (v_QP, lambda_QP) at its own rows (collected at
+  // x_k + h v_QP, the multipliers matched by key).
+  KktResiduals CalcFullStepCertificate(double h, const std::vector<IslandBody*>& bodies,
+                                       const std::vector<ConstraintSource*>& sources,
+                                       const SqpSettings& settings, StepStats& stats);
+  // True when the full QP step may be taken although the merit rejects it
+  // (SqpSettings::certificate_steps): its certificate's residual is below 0.9 x `residual` and
+  // its worst violation below max(`violation`, full_step_violation_factor x tolerance).
+  bool AcceptFullStep(double h, const std::vector<IslandBody*>& bodies,
+                      const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
+                      double residual, double violation, StepStats& stats);
 
   IslandRows rows_;
   std::vector<PgsRow> pgs_rows_;
@@ -61,7 +73,10 @@ class SqpSolver {
   std::vector<VecX> x_;  // (num_bodies) positions at a trial velocity
   MatX W_;
   VecX q_, lambda_, lambda_qp_, w_;
-  Eigen::RowVectorXd w_row_;  // one row of W being assembled
+  IslandRows full_rows_;       // rows at the full QP step
+  VecX full_lambda_;           // lambda_QP on full_rows_
+  KeyedMultipliers qp_keyed_;  // lambda_QP by key
+  Eigen::RowVectorXd w_row_;   // one row of W being assembled
   std::vector<VecX> v_k_, v_qp_, v_trial_, dv_;
   VecX scratch_, jt_;          // 3N work vectors (A dv, J^T lambda), reused across steps
   KeyedMultipliers previous_;  // last step's multipliers by key

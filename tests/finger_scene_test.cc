@@ -77,5 +77,32 @@ TEST(FingerSceneTest, BoneIsInsideTheFleshAndBadSettingsThrow) {
   EXPECT_THROW(FingerScene({}), InputError);
 }
 
+// The dual path's certificate steps (SqpSettings::certificate_steps, docs/math.md §5.7): in the
+// holds between presses the merit halves every full SQP step, so the SQP converges linearly at
+// rate 1/2 and ends its 10 iterations uncertified; taking the full steps that lower the
+// certificate's residual certifies those steps. Counted over the demo's run (520 steps of 1 ms).
+TEST(FingerSceneTest, CertificateStepsCertifyTheHoldsBetweenPresses) {
+  int unconverged[2] = {0, 0};
+  double max_violation[2] = {0.0, 0.0};
+  for (int on = 0; on < 2; ++on) {
+    FingerScene scene(FingerScene::DefaultPresses(), FingerSceneSettings());
+    scene.world().mutable_solver_settings().certificate_steps = on != 0;
+    for (int step = 0; step < 5000 && scene.current_press() < scene.num_presses(); ++step) {
+      scene.Step(1e-3);
+      const StepStats& stats = scene.world().last_step_stats();
+      unconverged[on] += stats.converged ? 0 : 1;
+      max_violation[on] = std::max(max_violation[on], stats.violation_after);
+    }
+    ASSERT_EQ(scene.current_press(), scene.num_presses());
+  }
+  std::printf(
+      "unconverged steps: %d with certificate steps (max violation %.2e), %d without "
+      "(%.2e)\n",
+      unconverged[1], max_violation[1], unconverged[0], max_violation[0]);
+  EXPECT_LE(unconverged[1], 5);
+  EXPECT_GE(unconverged[0], 15);
+  EXPECT_LE(max_violation[1], max_violation[0] * 1.01);
+}
+
 }  // namespace
 }  // namespace taut
