@@ -1,5 +1,6 @@
 #include "constraints/island_solver.h"
 
+#include <algorithm>
 #include <utility>
 
 namespace taut {
@@ -45,8 +46,10 @@ void IslandSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     // steps than the dual (finger: 46 vs 23 of 493, docs/report.md).
     const bool limit_rows_only =
         stats.rows_contact + stats.rows_rigid_contact + stats.rows_joint == 0;
-    if (!stats.converged && limit_rows_only && settings.solver == IslandSolverKind::kAuto)
-      primal_steps_left_ = kPrimalStepsAfterDualFailure;
+    if (!stats.converged && limit_rows_only && settings.solver == IslandSolverKind::kAuto) {
+      primal_steps_left_ = primal_window_;
+      primal_window_ = std::min(2 * primal_window_, kMaxPrimalSteps);
+    }
   }
   last_rows_ = stats.rows_total();
 }

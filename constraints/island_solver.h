@@ -22,8 +22,9 @@ class IslandSolver {
              const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
              StepStats& stats);
   // Steps the primal path keeps a limit-only island after the dual path failed its certificate
-  // there.
+  // there; each further failure after returning doubles it, up to kMaxPrimalSteps.
   static constexpr int kPrimalStepsAfterDualFailure = 20;
+  static constexpr int kMaxPrimalSteps = 640;
 
   // The path kAuto takes for an island with `rows` rows (last step) on `free_dofs` free DOFs,
   // `primal_steps_left` > 0 after a failed dual step.
@@ -35,12 +36,14 @@ class IslandSolver {
     KeyedMultipliers warm;      // last step's multipliers by row key
     int last_rows = 0;          // rows at the end of the last step
     int primal_steps_left = 0;  // steps the primal path keeps after a dual failure
+    int primal_window = kPrimalStepsAfterDualFailure;  // the next failure's primal_steps_left
   };
-  State SaveState() const { return {warm_, last_rows_, primal_steps_left_}; }
+  State SaveState() const { return {warm_, last_rows_, primal_steps_left_, primal_window_}; }
   void RestoreState(const State& state) {
     warm_ = state.warm;
     last_rows_ = state.last_rows;
     primal_steps_left_ = state.primal_steps_left;
+    primal_window_ = state.primal_window;
   }
 
   // The rows of the last Solve at its final velocities and their multipliers, one per row
@@ -54,10 +57,11 @@ class IslandSolver {
  private:
   SqpSolver dual_;
   PrimalSolver primal_;
-  KeyedMultipliers warm_;       // last step's multipliers by key, whichever path ran
-  int last_rows_ = 0;           // rows at the end of the last step
-  int primal_steps_left_ = 0;   // > 0: the dual path failed recently, stay primal
-  bool solved_primal_ = false;  // the last Solve took the primal path
+  KeyedMultipliers warm_;      // last step's multipliers by key, whichever path ran
+  int last_rows_ = 0;          // rows at the end of the last step
+  int primal_steps_left_ = 0;  // > 0: the dual path failed recently, stay primal
+  int primal_window_ = kPrimalStepsAfterDualFailure;  // primal steps after the next failure
+  bool solved_primal_ = false;                        // the last Solve took the primal path
 };
 
 }  // namespace taut

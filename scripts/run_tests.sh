@@ -113,7 +113,7 @@ asan_long_tests+='|RigidBoxOnASoftBlockComesToRest|RestitutionOfRigidContactsIns
 asan_long_tests+='|PinnedBarRestingOnASoftBlock|EverySceneRunTwiceGivesTheSameStateHash|StackRestsOnTheLimitedSphere'
 asan_long_tests+='|HyperbolicBandGivesTheSameStateAsAllRows|SaggingArmOfAHairpinRestsOnTheOtherArm'
 asan_long_tests+='|SnapshotOfAnotherWorldIsRefused|RestoredHexWorldContinuesBitIdentically|WorldSnapshotTest.*/primal'
-asan_long_tests+='|CertificateStepsCertifyTheHoldsBetweenPresses'
+asan_long_tests+='|CertificateStepsCertifyTheHoldsBetweenPresses|AutoPathLeavesFewUncertifiedSteps'
 
 # Stage 3: Debug build with AddressSanitizer + UBSan and its tests (without the long ones above).
 stage_asan() {

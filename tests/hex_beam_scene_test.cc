@@ -41,6 +41,24 @@ TEST(HexBeamSceneTest, EnergyLimitsOrderTheSagAndHoldEveryStep) {
   EXPECT_GT(tip[3], tip[4]);
 }
 
+// The auto path on the energy-limited beams (limit rows only): after the dual path fails its
+// certificate the island stays primal for 20 steps, and for twice as long after each further
+// failure (IslandSolver::kMaxPrimalSteps); with a fixed 20-step window 19 of the 480 steps of
+// `taut-demo hex_beam` were uncertified, one per return to the dual path.
+TEST(HexBeamSceneTest, AutoPathLeavesFewUncertifiedSteps) {
+  HexBeamScene scene(HexBeamScene::DefaultBeams());
+  int unconverged = 0, primal = 0;
+  for (int step = 0; step < 480; ++step) {
+    scene.Step(1.0 / 240.0);
+    const StepStats& stats = scene.world().last_step_stats();
+    unconverged += stats.converged ? 0 : 1;
+    primal += stats.islands_primal;
+  }
+  std::printf("hex_beam, auto: %d of 480 steps uncertified, %d primal island solves\n", unconverged,
+              primal);
+  EXPECT_LE(unconverged, 6);
+}
+
 }  // namespace
 }  // namespace taut
 
