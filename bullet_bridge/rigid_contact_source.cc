@@ -203,13 +203,14 @@ bool RigidContactSource::CombineCornerPoints(const Triangle& corners, const Vec3
   return true;
 }
 
-bool RigidContactSource::FindFaceContact(size_t t, const VecX& x, const btCollisionShape& shape,
+bool RigidContactSource::FindFaceContact(size_t t, const std::vector<Vec3>& point_x,
+                                         const btCollisionShape& shape,
                                          const btTransform& transform, FaceContact& contact) const {
   if (!shape.isConvex()) return false;  // planes, meshes and compounds: points only
   const Triangle& corners = triangles_[t];
-  const Vec3 a = CalcContactPointPosition(points_[corners[0]], x);
-  const Vec3 b = CalcContactPointPosition(points_[corners[1]], x);
-  const Vec3 c = CalcContactPointPosition(points_[corners[2]], x);
+  const Vec3& a = point_x[corners[0]];
+  const Vec3& b = point_x[corners[1]];
+  const Vec3& c = point_x[corners[2]];
   Vec3 n = (b - a).cross(c - a);  // outward (the surface is wound outward)
   const double norm = n.norm();
   if (!(norm > 0.0)) return false;
@@ -253,11 +254,15 @@ void RigidContactSource::AppendFaceRows(const IslandIterate& iterate, size_t o,
   shape.getAabb(transform, lo, hi);
   const Vec3 grow = Vec3::Constant(margin_);
   const Eigen::AlignedBox3d bounds(ToEigen(lo) - grow, ToEigen(hi) + grow);
+  // Each point once (a surface vertex is a corner of about six triangles).
+  point_x_.resize(points_.size());
+  for (size_t i = 0; i < points_.size(); ++i) point_x_[i] = CalcContactPointPosition(points_[i], x);
   FaceContact contact;
   for (size_t t = 0; t < triangles_.size(); ++t) {
     Eigen::AlignedBox3d box;
-    for (int corner : triangles_[t]) box.extend(CalcContactPointPosition(points_[corner], x));
-    if (!bounds.intersects(box) || !FindFaceContact(t, x, shape, transform, contact)) continue;
+    for (int corner : triangles_[t]) box.extend(point_x_[corner]);
+    if (!bounds.intersects(box) || !FindFaceContact(t, point_x_, shape, transform, contact))
+      continue;
     if (!Moves(contact.point)) continue;
     AppendContactRows(iterate, partner, contact.point, static_cast<int>(t), kRigidFaceRowOffset,
                       contact.gap, contact.normal, contact.q, com, rows);

@@ -85,8 +85,8 @@ class RigidContactSource final : public ConstraintSource {
                          const ContactPoint& point, int index, int row_offset, double gap,
                          const Vec3& n, const Vec3& q, const Vec3& com,
                          std::vector<ConstraintRow>& rows) const;
-  // The closest points of surface triangle t at positions x and a convex shape, when the shape
-  // is outside the face within the margin (docs/math.md §5.5, face contact).
+  // The closest points of surface triangle t (its corners at point_x) and a convex shape, when the
+  // shape is outside the face within the margin (docs/math.md §5.5, face contact).
   struct FaceContact {
     ContactPoint point;  // the triangle's nodes with the barycentric weights of its closest point
     double gap = 0.0;    // distance from the triangle to the shape's surface (< 0: penetration)
@@ -95,7 +95,7 @@ class RigidContactSource final : public ConstraintSource {
   };
   // False when the shape is not convex, lies behind the triangle, is farther than the margin,
   // or is deeper into the triangle than its own collision margin.
-  bool FindFaceContact(size_t t, const VecX& x, const btCollisionShape& shape,
+  bool FindFaceContact(size_t t, const std::vector<Vec3>& point_x, const btCollisionShape& shape,
                        const btTransform& transform, FaceContact& contact) const;
   // point = sum_k beta_k (corner k's point) over the triangle's corners, equal nodes merged;
   // false when that spans more nodes than a contact point holds (8).
@@ -118,6 +118,7 @@ class RigidContactSource final : public ConstraintSource {
   std::vector<ContactPoint> points_;
   std::vector<Triangle> triangles_;               // indices into points_
   mutable std::vector<ConstraintRow> face_rows_;  // CalcIslandViolationSum's face rows (reused)
+  mutable std::vector<Vec3> point_x_;             // AppendFaceRows: the points' positions
   bool face_contact_ = false;
   std::vector<ContactPartner> partners_;
 };

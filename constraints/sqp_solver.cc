@@ -105,7 +105,7 @@ KktResiduals SqpSolver::CalcFullStepCertificate(double h, const std::vector<Isla
                                                 const SqpSettings& settings, StepStats& stats) {
   const auto t_rows = std::chrono::steady_clock::now();
   const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
-  full_rows_.Collect(h, bodies, sources, v_qp_, distance_scale);
+  full_violation_ = full_rows_.Collect(h, bodies, sources, v_qp_, distance_scale);
   stats.ms_rows += MsSince(t_rows);
   rows_.Store(lambda_qp_, qp_keyed_);
   full_rows_.WarmStart(qp_keyed_, full_lambda_);
@@ -155,10 +155,18 @@ void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
   }
   double rho = 0.0, last_alpha = 1.0;
   bool restoring = false;
+  full_rows_at_v_k_ = false;
   for (int k = 0;; ++k) {
-    auto t_rows = std::chrono::steady_clock::now();
-    const double violation = rows_.Collect(h, bodies, sources, v_k_, distance_scale);
-    stats.ms_rows += MsSince(t_rows);
+    double violation = full_violation_;
+    if (full_rows_at_v_k_) {
+      // A certificate step moved v_k to v_QP exactly: its rows are already collected there.
+      std::swap(rows_, full_rows_);
+      full_rows_at_v_k_ = false;
+    } else {
+      const auto t_rows = std::chrono::steady_clock::now();
+      violation = rows_.Collect(h, bodies, sources, v_k_, distance_scale);
+      stats.ms_rows += MsSince(t_rows);
+    }
     if (k == 0) stats.violation_before = violation;
     stats.violation_after = violation;
     rows_.CountTypes(stats);
@@ -252,16 +260,25 @@ void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     double alpha = 1.0;
     const double residual_k =
         CalcCertificateResidual(kkt, settings.violation_tolerance, settings.stationarity_tolerance);
+    bool certificate_step = false;
     for (int halving = 0; halving < settings.max_line_search_halvings; ++halving) {
       for (size_t b = 0; b < nb; ++b) v_trial_[b] = v_k_[b] + alpha * (v_qp_[b] - v_k_[b]);
       if (CalcMerit(h, bodies, sources, v_trial_, rho) <= phi_k - 1e-4 * alpha * step_norm) break;
-      if (halving == 0 && settings.certificate_steps &&
-          AcceptFullStep(h, bodies, sources, settings, residual_k, kkt.max_primal(), stats))
-        break;
+      certificate_step =
+          halving == 0 && settings.certificate_steps &&
+          AcceptFullStep(h, bodies, sources, settings, residual_k, kkt.max_primal(), stats);
+      if (certificate_step) break;
       alpha *= 0.5;
     }
-    for (size_t b = 0; b < nb; ++b) v_k_[b] += alpha * (v_qp_[b] - v_k_[b]);
-    lambda_ += alpha * (lambda_qp_ - lambda_);
+    if (certificate_step) {
+      // (v_QP, lambda_QP) exactly, so the next iteration takes the rows just collected there.
+      v_k_ = v_qp_;
+      lambda_ = lambda_qp_;
+      full_rows_at_v_k_ = true;
+    } else {
+      for (size_t b = 0; b < nb; ++b) v_k_[b] += alpha * (v_qp_[b] - v_k_[b]);
+      lambda_ += alpha * (lambda_qp_ - lambda_);
+    }
     last_alpha = alpha;
     rows_.Store(lambda_, iterate_);
     stats.sqp_iterations = k + 1;

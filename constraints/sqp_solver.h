@@ -73,10 +73,12 @@ class SqpSolver {
   std::vector<VecX> x_;  // (num_bodies) positions at a trial velocity
   MatX W_;
   VecX q_, lambda_, lambda_qp_, w_;
-  IslandRows full_rows_;       // rows at the full QP step
-  VecX full_lambda_;           // lambda_QP on full_rows_
-  KeyedMultipliers qp_keyed_;  // lambda_QP by key
-  Eigen::RowVectorXd w_row_;   // one row of W being assembled
+  IslandRows full_rows_;           // rows at the full QP step
+  double full_violation_ = 0.0;    // their largest violation (IslandRows::Collect)
+  bool full_rows_at_v_k_ = false;  // a certificate step was taken: full_rows_ are v_k's rows
+  VecX full_lambda_;               // lambda_QP on full_rows_
+  KeyedMultipliers qp_keyed_;      // lambda_QP by key
+  Eigen::RowVectorXd w_row_;       // one row of W being assembled
   std::vector<VecX> v_k_, v_qp_, v_trial_, dv_;
   VecX scratch_, jt_;          // 3N work vectors (A dv, J^T lambda), reused across steps
   KeyedMultipliers previous_;  // last step's multipliers by key
