@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "constraints/strain_frame_curvature.h"
 #include "constraints/strain_limit_curvature.h"
 #include "plugin/tet_rest_data.h"
 
@@ -85,12 +86,21 @@ void StrainLimitConstraint::AddIslandCurvature(const IslandIterate& iterate,
                                                const ConstraintRow* rows, const double* weights,
                                                int count, CurvatureSink& sink) const {
   // Rows of one element are adjacent: one SVD per element, and sum_c w_c H_c of its rows is
-  // scattered once (16 node blocks per element, not per row).
+  // scattered once (16 node blocks per element, not per row). Frame-dependent rows sum their
+  // full curvature over vec(P) and clamp the element's sum once (docs/math.md §5.9); the others
+  // clamp each row's stretch term (§5.9).
+  const bool full_curvature = HasStrainFrameCurvature(params_);
   int element = -1, body = -1;
   SignedSvd svd;
   Mat12 sum = Mat12::Zero();
+  Mat9 principal_sum = Mat9::Zero();
   const auto flush = [&] {
-    if (element >= 0) sink.AddElementBlock(body, element, tets_.element_nodes(element), sum);
+    if (element < 0) return;
+    if (full_curvature) {
+      sum = MapPrincipalHessianToTet(ClampNegativeModes(principal_sum), svd,
+                                     tets_.rest().elements[element].r);
+    }
+    sink.AddElementBlock(body, element, tets_.element_nodes(element), sum);
   };
   for (int c = 0; c < count; ++c) {
     const ConstraintRow& row = rows[c];
@@ -102,11 +112,15 @@ void StrainLimitConstraint::AddIslandCurvature(const IslandIterate& iterate,
       element = key.element;
       body = row.body;
       sum.setZero();
+      principal_sum.setZero();
       svd = FindOrCalcSvd(element, tets_.GatherElement(iterate.x(row.body), element));
     }
-    sum.noalias() +=
-        weights[c] * CalcStrainLimitRowCurvature(r, svd, SelectStrainLimitFrame(settings_, element),
-                                                 params_, key);
+    const Mat3& Q = SelectStrainLimitFrame(settings_, element);
+    if (full_curvature) {
+      principal_sum.noalias() += weights[c] * CalcPrincipalStrainRowCurvature(svd, Q, params_, key);
+    } else {
+      sum.noalias() += weights[c] * CalcStrainLimitRowCurvature(r, svd, Q, params_, key);
+    }
   }
   flush();
 }

@@ -126,6 +126,7 @@ StrainLimitParams CalcStrainLimitParams(const StrainLimitSettings& settings) {
   params.activation_margin = settings.activation_margin;
   params.svd_gap_epsilon = settings.svd_gap_epsilon;
   params.freeze_frame_jacobian = settings.freeze_frame_jacobian;
+  params.full_frame_curvature = settings.full_frame_curvature;
   params.hyperbolic_row_band = settings.hyperbolic_row_band;
   params.projection = SelectEvaluatedProjection(settings, params);
   return params;

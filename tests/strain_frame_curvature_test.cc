@@ -1,0 +1,226 @@
+// The full curvature of frame-dependent strain rows (constraints/strain_frame_curvature.h):
+// against central differences of the exact row Jacobian and second differences of the row value,
+// on random well-separated and inverted states, for hyperbolic and unequal ellipsoid limits.
+#include "constraints/strain_frame_curvature.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+namespace taut {
+namespace {
+
+Mat3 RandomFrameRotation(std::mt19937* rng) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  Eigen::Quaterniond q(n(*rng), n(*rng), n(*rng), n(*rng));
+  return q.normalized().toRotationMatrix();
+}
+
+// Signed values sorted by |s| descending with gaps >= 0.1 (of s_a - s_b and s_a + s_b), on both
+// sides of 1; s_3 < 0 a fifth of the time.
+Vec3 RandomFrameTestValues(std::mt19937* rng) {
+  std::uniform_real_distribution<double> u(0.6, 1.4), coin(0.0, 1.0);
+  while (true) {
+    Vec3 s(u(*rng), u(*rng), u(*rng));
+    std::sort(s.data(), s.data() + 3, [](double a, double b) { return a > b; });
+    if (s[0] - s[1] < 0.1 || s[1] - s[2] < 0.1) continue;
+    if (coin(*rng) < 0.2) s[2] = -s[2];
+    return s;
+  }
+}
+
+// A regular rest tet scaled by 0.3: rows r_n of the inverse edge matrix, rest nodes X.
+TetRestRows MakeFrameTestRest(std::array<Vec3, 4>* X) {
+  *X = {Vec3(0.3, 0.3, 0.3), Vec3(0.3, -0.3, -0.3), Vec3(-0.3, 0.3, -0.3), Vec3(-0.3, -0.3, 0.3)};
+  Mat3 X0;
+  for (int c = 0; c < 3; ++c) X0.col(c) = (*X)[c] - (*X)[3];
+  const Mat3 inv = X0.inverse();
+  TetRestRows r;
+  for (int n = 0; n < 3; ++n) r[n] = inv.row(n).transpose();
+  r[3] = -(r[0] + r[1] + r[2]);
+  return r;
+}
+
+StrainLimitParams MakeFrameTestParams(StrainProjection projection) {
+  StrainLimitParams params;
+  params.projection = projection;
+  params.kappa_max = Vec3(0.0, 2.0, 5.0);
+  params.kappa_min = Vec3(1.5, 0.0, 3.0);
+  params.has_max = params.has_min = true;
+  params.activation_margin = 1e9;    // emit every row
+  params.hyperbolic_row_band = 1e9;  // every (j, i), not only the dominant one
+  params.svd_gap_epsilon = 1e-6;     // inactive at these gaps
+  params.full_frame_curvature = true;
+  return params;
+}
+
+TetPositions DisplaceFrameTestNodes(const TetPositions& x, const Vec12& dx) {
+  TetPositions out = x;
+  for (int n = 0; n < 4; ++n) out[n] += dx.segment<3>(3 * n);
+  return out;
+}
+
+const StrainLimitRow* FindFrameTestRow(const std::vector<StrainLimitRow>& rows,
+                                       const StrainLimitKey& key) {
+  for (const StrainLimitRow& row : rows)
+    if (row.key == key) return &row;
+  return nullptr;
+}
+
+// A state with node positions x_n = F X_n (so G = F), its rows and its limit frame.
+struct FrameTestState {
+  TetRestRows r;
+  TetPositions x;
+  Mat3 Q;
+  std::vector<StrainLimitRow> rows;
+};
+
+FrameTestState MakeFrameTestState(std::mt19937* rng, const StrainLimitParams& params) {
+  FrameTestState state;
+  std::array<Vec3, 4> X;
+  state.r = MakeFrameTestRest(&X);
+  const Mat3 F = RandomFrameRotation(rng) * RandomFrameTestValues(rng).asDiagonal() *
+                 RandomFrameRotation(rng).transpose();
+  for (int n = 0; n < 4; ++n) state.x[n] = F * X[n];
+  state.Q = RandomFrameRotation(rng);
+  AppendStrainLimitRows(0, state.r, state.x, state.Q, params, &state.rows);
+  return state;
+}
+
+// Rows whose frame factor is far from the hyperbolic |V'_ji| kink (there C is not C^2).
+bool IsAwayFromKink(const FrameTestState& state, const StrainLimitParams& params,
+                    const StrainLimitRow& row) {
+  if (params.projection != StrainProjection::kHyperbolic) return true;
+  const SignedSvd svd = CalcSignedSvd(CalcTetDeformationGradient(state.r, state.x));
+  const Mat3 V_prime = state.Q.transpose() * svd.V;
+  return std::abs(V_prime(row.key.axis, row.principal_index)) > 0.05;
+}
+
+class StrainFrameCurvatureTest : public ::testing::TestWithParam<StrainProjection> {};
+
+// -d^2 C/dx^2 against -dJ/dx by central differences of the exact Jacobian (dV/dx included).
+TEST_P(StrainFrameCurvatureTest, MatchesFdOfTheRowJacobian) {
+  const StrainLimitParams params = MakeFrameTestParams(GetParam());
+  std::mt19937 rng(7);
+  double worst = 0.0;
+  int checked = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const FrameTestState state = MakeFrameTestState(&rng, params);
+    const SignedSvd svd = CalcSignedSvd(CalcTetDeformationGradient(state.r, state.x));
+    for (const StrainLimitRow& row : state.rows) {
+      if (!IsAwayFromKink(state, params, row)) continue;
+      const Mat12 H = MapPrincipalHessianToTet(
+          CalcPrincipalStrainRowCurvature(svd, state.Q, params, row.key), svd, state.r);
+      Mat12 fd;
+      bool matched = true;
+      const double t = 1e-6;
+      for (int k = 0; k < 12 && matched; ++k) {
+        std::vector<StrainLimitRow> plus, minus;
+        AppendStrainLimitRows(0, state.r, DisplaceFrameTestNodes(state.x, t * Vec12::Unit(k)),
+                              state.Q, params, &plus);
+        AppendStrainLimitRows(0, state.r, DisplaceFrameTestNodes(state.x, -t * Vec12::Unit(k)),
+                              state.Q, params, &minus);
+        const StrainLimitRow* p = FindFrameTestRow(plus, row.key);
+        const StrainLimitRow* m = FindFrameTestRow(minus, row.key);
+        matched = p != nullptr && m != nullptr;
+        if (matched) fd.col(k) = -(p->J - m->J) / (2.0 * t);
+      }
+      if (!matched) continue;
+      worst = std::max(worst, (H - fd).cwiseAbs().maxCoeff() / std::max(1.0, fd.norm()));
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 200);
+  EXPECT_LT(worst, 1e-5);
+}
+
+// d^2 C along random directions against second differences of the row value C alone.
+TEST_P(StrainFrameCurvatureTest, MatchesSecondDifferencesOfTheRowValue) {
+  const StrainLimitParams params = MakeFrameTestParams(GetParam());
+  std::mt19937 rng(11);
+  std::normal_distribution<double> n(0.0, 1.0);
+  double worst = 0.0;
+  int checked = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const FrameTestState state = MakeFrameTestState(&rng, params);
+    const SignedSvd svd = CalcSignedSvd(CalcTetDeformationGradient(state.r, state.x));
+    Vec12 d;
+    for (int k = 0; k < 12; ++k) d[k] = n(rng);
+    const double t = 2e-5;  // truncation O(t^2) and round-off O(eps / t^2) both below 1e-5
+    std::vector<StrainLimitRow> plus, minus;
+    AppendStrainLimitRows(0, state.r, DisplaceFrameTestNodes(state.x, t * d), state.Q, params,
+                          &plus);
+    AppendStrainLimitRows(0, state.r, DisplaceFrameTestNodes(state.x, -t * d), state.Q, params,
+                          &minus);
+    for (const StrainLimitRow& row : state.rows) {
+      if (!IsAwayFromKink(state, params, row)) continue;
+      const StrainLimitRow* p = FindFrameTestRow(plus, row.key);
+      const StrainLimitRow* m = FindFrameTestRow(minus, row.key);
+      if (p == nullptr || m == nullptr) continue;
+      const Mat12 H = MapPrincipalHessianToTet(
+          CalcPrincipalStrainRowCurvature(svd, state.Q, params, row.key), svd, state.r);
+      const double second_difference = (p->C - 2.0 * row.C + m->C) / (t * t);
+      const double analytic = -d.dot(H * d);
+      worst = std::max(worst,
+                       std::abs(analytic - second_difference) / std::max(1.0, std::abs(analytic)));
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 200);
+  EXPECT_LT(worst, 1e-4);
+}
+
+INSTANTIATE_TEST_SUITE_P(FrameDependentRows, StrainFrameCurvatureTest,
+                         ::testing::Values(StrainProjection::kHyperbolic,
+                                           StrainProjection::kEllipsoid));
+
+// With equal weights the frame factor is constant, and the curvature is kappa times that of s_i
+// (constraints/singular_value_hessian.h), so the frame terms add nothing there.
+TEST(StrainFrameCurvatureIsotropicTest, ReducesToTheStretchCurvature) {
+  StrainLimitParams params = MakeFrameTestParams(StrainProjection::kEllipsoid);
+  params.kappa_max = Vec3::Constant(4.0);
+  params.kappa_min = Vec3::Constant(2.0);
+  EXPECT_FALSE(HasStrainFrameCurvature(params));
+  std::mt19937 rng(5);
+  double worst = 0.0;
+  for (int trial = 0; trial < 100; ++trial) {
+    const FrameTestState state = MakeFrameTestState(&rng, params);
+    const SignedSvd svd = CalcSignedSvd(CalcTetDeformationGradient(state.r, state.x));
+    for (const StrainLimitRow& row : state.rows) {
+      const bool is_max = row.key.bound == StrainBound::kMax;
+      const double scale = is_max ? 4.0 : -2.0;  // sigma kappa
+      const Mat12 expected = CalcTetSingularValueHessian(
+          CalcSingularValueHessian(svd, row.principal_index, params.svd_gap_epsilon), state.r,
+          scale, /*clamp_negative=*/false);
+      const Mat12 H = MapPrincipalHessianToTet(
+          CalcPrincipalStrainRowCurvature(svd, state.Q, params, row.key), svd, state.r);
+      worst =
+          std::max(worst, (H - expected).cwiseAbs().maxCoeff() / std::max(1.0, expected.norm()));
+    }
+  }
+  EXPECT_LT(worst, 1e-12);
+}
+
+TEST(StrainFrameCurvatureClampTest, KeepsThePositivePartOnly) {
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n(0.0, 1.0);
+  for (int trial = 0; trial < 50; ++trial) {
+    Mat9 A;
+    for (int k = 0; k < 81; ++k) A.data()[k] = n(rng);
+    const Mat9 H = A + A.transpose();
+    const Mat9 clamped = ClampNegativeModes(H);
+    const Eigen::SelfAdjointEigenSolver<Mat9> of_clamped(clamped), of_rest(H - clamped);
+    EXPECT_GT(of_clamped.eigenvalues().minCoeff(), -1e-12);  // PSD
+    EXPECT_LT(of_rest.eigenvalues().maxCoeff(), 1e-12);      // only negative modes removed
+    const Mat9 psd = A * A.transpose();
+    EXPECT_LT((ClampNegativeModes(psd) - psd).cwiseAbs().maxCoeff(), 1e-10 * psd.norm());
+  }
+}
+
+}  // namespace
+}  // namespace taut
