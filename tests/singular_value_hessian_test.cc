@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "constraints/strain_limit_curvature.h"
+#include "tests/test_utils.h"
 
 namespace taut {
 namespace {
@@ -24,24 +25,11 @@ constexpr StrainProjection kAllModes[] = {
     StrainProjection::kHyperbolic, StrainProjection::kOrthogonal,
     StrainProjection::kLinearInterpolation, StrainProjection::kEllipsoid};
 
-// Uniformly random rotation from a normalized Gaussian quaternion.
-Mat3 RandomRotation(std::mt19937* rng) {
-  std::normal_distribution<double> n(0.0, 1.0);
-  Eigen::Quaterniond q(n(*rng), n(*rng), n(*rng), n(*rng));
-  return q.normalized().toRotationMatrix();
-}
+using testing::RandomRotation;
 
-// Signed values with |s| sorted descending, pairwise gaps (of |s| and of s_a + s_b) >= 0.1;
-// s_3 < 0 (inverted) a quarter of the time.
+// Signed values in [0.5, 1.5], gaps >= 0.1, s_3 < 0 (inverted) a quarter of the time.
 Vec3 RandomSeparatedValues(std::mt19937* rng) {
-  std::uniform_real_distribution<double> u(0.5, 1.5), coin(0.0, 1.0);
-  while (true) {
-    Vec3 s(u(*rng), u(*rng), u(*rng));
-    std::sort(s.data(), s.data() + 3, [](double a, double b) { return a > b; });
-    if (s[0] - s[1] < 0.1 || s[1] - s[2] < 0.1) continue;
-    if (coin(*rng) < 0.25) s[2] = -s[2];
-    return s;
-  }
+  return testing::RandomSeparatedSignedValues(*rng, 0.5, 1.5, 0.25);
 }
 
 // A perturbed regular rest tet: rows r_n and rest nodes X.
@@ -76,7 +64,7 @@ TEST(SingularValueHessianTest, MatchesFdOfTheGradient) {
   double worst = 0.0;
   for (int trial = 0; trial < 300; ++trial) {
     const Vec3 s = RandomSeparatedValues(&rng);
-    const Mat3 F = RandomRotation(&rng) * s.asDiagonal() * RandomRotation(&rng).transpose();
+    const Mat3 F = RandomRotation(rng) * s.asDiagonal() * RandomRotation(rng).transpose();
     const SignedSvd svd = CalcSignedSvd(F);
     for (int i = 0; i < 3; ++i) {
       const Mat9 H = CalcDenseSingularValueHessian(CalcSingularValueHessian(svd, i, 0.0));
@@ -110,7 +98,7 @@ TEST(SingularValueHessianTest, EigenvaluesAreTheInverseGaps) {
   const Vec3 s(1.4, 1.1, -0.6);
   std::mt19937 rng(2);
   const SignedSvd svd =
-      CalcSignedSvd(RandomRotation(&rng) * s.asDiagonal() * RandomRotation(&rng).transpose());
+      CalcSignedSvd(RandomRotation(rng) * s.asDiagonal() * RandomRotation(rng).transpose());
   const SingularValueHessian hessian = CalcSingularValueHessian(svd, 1, 0.0);
   EXPECT_NEAR(hessian.eigenvalues[0], 1.0 / (1.1 - 1.4), 1e-9);
   EXPECT_NEAR(hessian.eigenvalues[1], 1.0 / (1.1 + 1.4), 1e-9);
@@ -135,11 +123,11 @@ TEST(SingularValueHessianTest, NodeAssemblyMatchesFdOfTheRowJacobian) {
   for (int trial = 0; trial < 200; ++trial) {
     std::array<Vec3, 4> X;
     const TetRestRows r = MakeRestRows(&rng, &X);
-    const Mat3 G = RandomRotation(&rng) * RandomSeparatedValues(&rng).asDiagonal() *
-                   RandomRotation(&rng).transpose();
+    const Mat3 G = RandomRotation(rng) * RandomSeparatedValues(&rng).asDiagonal() *
+                   RandomRotation(rng).transpose();
     TetPositions x;
     for (int n = 0; n < 4; ++n) x[n] = G * X[n];
-    const Mat3 Q = RandomRotation(&rng);
+    const Mat3 Q = RandomRotation(rng);
     std::vector<StrainLimitRow> rows;
     AppendStrainLimitRows(0, r, x, Q, params, &rows);
     const SignedSvd svd = CalcSignedSvd(G);
@@ -208,10 +196,10 @@ TEST(SingularValueHessianTest, ClampedCurvatureIsPsdAndBounded) {
       Vec3 s = RandomSeparatedValues(&rng);
       if (trial % 3 == 1) s[1] = s[0] - delta;
       if (trial % 3 == 2) s = Vec3(1.3, 0.7, -0.7 + delta);
-      const Mat3 G = RandomRotation(&rng) * s.asDiagonal() * RandomRotation(&rng).transpose();
+      const Mat3 G = RandomRotation(rng) * s.asDiagonal() * RandomRotation(rng).transpose();
       TetPositions x;
       for (int n = 0; n < 4; ++n) x[n] = G * X[n];
-      const Mat3 Q = RandomRotation(&rng);
+      const Mat3 Q = RandomRotation(rng);
       std::vector<StrainLimitRow> rows;
       AppendStrainLimitRows(0, r, x, Q, params, &rows);
       const SignedSvd svd = CalcSignedSvd(G);
@@ -241,7 +229,7 @@ TEST(SingularValueHessianTest, ClampedCurvatureIsPsdAndBounded) {
 // Away from the clamp (gaps above rho) the clamped eigenvalues equal the exact ones.
 TEST(SingularValueHessianTest, GapClampOnlyActsOnSmallGaps) {
   std::mt19937 rng(5);
-  const Mat3 R = RandomRotation(&rng), S = RandomRotation(&rng);
+  const Mat3 R = RandomRotation(rng), S = RandomRotation(rng);
   const SignedSvd wide = CalcSignedSvd(R * Vec3(1.3, 1.0, 0.7).asDiagonal() * S.transpose());
   const SingularValueHessian exact = CalcSingularValueHessian(wide, 0, 0.0);
   const SingularValueHessian clamped = CalcSingularValueHessian(wide, 0, 1e-2);

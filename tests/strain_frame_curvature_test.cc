@@ -12,26 +12,16 @@
 #include <random>
 #include <vector>
 
+#include "tests/test_utils.h"
+
 namespace taut {
 namespace {
 
-Mat3 RandomFrameRotation(std::mt19937* rng) {
-  std::normal_distribution<double> n(0.0, 1.0);
-  Eigen::Quaterniond q(n(*rng), n(*rng), n(*rng), n(*rng));
-  return q.normalized().toRotationMatrix();
-}
+using testing::RandomRotation;
 
-// Signed values sorted by |s| descending with gaps >= 0.1 (of s_a - s_b and s_a + s_b), on both
-// sides of 1; s_3 < 0 a fifth of the time.
+// Signed values in [0.6, 1.4], gaps >= 0.1, s_3 < 0 a fifth of the time.
 Vec3 RandomFrameTestValues(std::mt19937* rng) {
-  std::uniform_real_distribution<double> u(0.6, 1.4), coin(0.0, 1.0);
-  while (true) {
-    Vec3 s(u(*rng), u(*rng), u(*rng));
-    std::sort(s.data(), s.data() + 3, [](double a, double b) { return a > b; });
-    if (s[0] - s[1] < 0.1 || s[1] - s[2] < 0.1) continue;
-    if (coin(*rng) < 0.2) s[2] = -s[2];
-    return s;
-  }
+  return testing::RandomSeparatedSignedValues(*rng, 0.6, 1.4, 0.2);
 }
 
 // A regular rest tet scaled by 0.3: rows r_n of the inverse edge matrix, rest nodes X.
@@ -84,10 +74,10 @@ FrameTestState MakeFrameTestState(std::mt19937* rng, const StrainLimitParams& pa
   FrameTestState state;
   std::array<Vec3, 4> X;
   state.r = MakeFrameTestRest(&X);
-  const Mat3 F = RandomFrameRotation(rng) * RandomFrameTestValues(rng).asDiagonal() *
-                 RandomFrameRotation(rng).transpose();
+  const Mat3 F = RandomRotation(*rng) * RandomFrameTestValues(rng).asDiagonal() *
+                 RandomRotation(*rng).transpose();
   for (int n = 0; n < 4; ++n) state.x[n] = F * X[n];
-  state.Q = RandomFrameRotation(rng);
+  state.Q = RandomRotation(*rng);
   AppendStrainLimitRows(0, state.r, state.x, state.Q, params, &state.rows);
   return state;
 }

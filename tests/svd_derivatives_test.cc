@@ -10,15 +10,12 @@
 #include <random>
 #include <vector>
 
+#include "tests/test_utils.h"
+
 namespace taut {
 namespace {
 
-// Uniformly random rotation from a normalized Gaussian quaternion.
-Mat3 RandomRotation(std::mt19937* rng) {
-  std::normal_distribution<double> n(0.0, 1.0);
-  Eigen::Quaterniond q(n(*rng), n(*rng), n(*rng), n(*rng));
-  return q.normalized().toRotationMatrix();
-}
+using testing::RandomRotation;
 
 // A random positively oriented rest tet (perturbed regular tet) and its rest rows r_1..r_4.
 TetRestRows RandomRestRows(std::mt19937* rng, std::array<Vec3, 4>* X_out) {
@@ -85,7 +82,7 @@ Mat3 RandomG(std::mt19937* rng, bool inverted) {
   std::uniform_real_distribution<double> u(0.5, 1.5);
   Vec3 s(u(*rng), u(*rng), u(*rng));
   if (inverted) s[2] = -s[2];
-  return RandomRotation(rng) * s.asDiagonal() * RandomRotation(rng).transpose();
+  return RandomRotation(*rng) * s.asDiagonal() * RandomRotation(*rng).transpose();
 }
 
 double Percentile(std::vector<double> v, double p) {
@@ -150,7 +147,7 @@ TEST(SvdDerivativesTest, SingularVectorGradientExactNearRepeatedValuesWithSmallS
       std::array<Vec3, 4> X;
       const TetRestRows r = RandomRestRows(&rng, &X);
       const Vec3 s = inverted_pair ? Vec3(1.5, 0.5, -0.5 + delta) : Vec3(1.2, 1.2 - delta, 0.8);
-      const Mat3 G = RandomRotation(&rng) * s.asDiagonal() * RandomRotation(&rng).transpose();
+      const Mat3 G = RandomRotation(rng) * s.asDiagonal() * RandomRotation(rng).transpose();
       const TetPositions x = PositionsFromG(G, X, Vec3::Zero());
       const SignedSvd svd = CalcSignedSvd(CalcTetDeformationGradient(r, x));
       double max_err = 0.0, max_norm = 0.0;
@@ -177,7 +174,7 @@ TEST(SvdDerivativesTest, GapClampActsOnlyBelowEpsilon) {
   std::mt19937 rng(4);
   std::array<Vec3, 4> X;
   const TetRestRows r = RandomRestRows(&rng, &X);
-  const Mat3 Ru = RandomRotation(&rng), Rv = RandomRotation(&rng);
+  const Mat3 Ru = RandomRotation(rng), Rv = RandomRotation(rng);
   // s_1^2 - s_2^2 = 2.4 delta - delta^2: above 1e-2 at delta = 1e-2, below at 1e-3 and 1e-5.
   for (const double delta : {1e-2, 1e-3, 1e-5}) {
     const Vec3 s(1.2, 1.2 - delta, 0.8);
@@ -256,7 +253,7 @@ TEST(SvdDerivativesTest, ClosedFormEqualsGenericFormAndIsTranslationInvariant) {
     const TetRestRows r = RandomRestRows(&rng, &X);
     // Every third state has nearly repeated values, so the clamp is active.
     Mat3 G = RandomG(&rng, trial % 2 == 0);
-    if (trial % 3 == 0) G = RandomRotation(&rng) * Vec3(1.1, 1.1 - 1e-4, 0.7).asDiagonal();
+    if (trial % 3 == 0) G = RandomRotation(rng) * Vec3(1.1, 1.1 - 1e-4, 0.7).asDiagonal();
     const SignedSvd svd = CalcSignedSvd(G);
     for (int i = 0; i < 3; ++i) {
       const Mat3x12 dv = CalcSingularVectorGradient(svd, r, i, 1e-2);

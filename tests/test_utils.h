@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <functional>
 #include <random>
 
@@ -14,6 +15,21 @@ inline Mat3 RandomRotation(std::mt19937& rng) {
   std::normal_distribution<double> n(0.0, 1.0);
   Eigen::Quaterniond q(n(rng), n(rng), n(rng), n(rng));
   return q.normalized().toRotationMatrix();
+}
+
+// Signed singular values in [lo, hi] sorted by |s| descending with pairwise gaps >= 0.1 (of
+// s_a - s_b, hence also of s_a + s_b), s_3 negated (an inverted element) with probability
+// inverted_fraction.
+inline Vec3 RandomSeparatedSignedValues(std::mt19937& rng, double lo, double hi,
+                                        double inverted_fraction) {
+  std::uniform_real_distribution<double> u(lo, hi), coin(0.0, 1.0);
+  while (true) {
+    Vec3 s(u(rng), u(rng), u(rng));
+    std::sort(s.data(), s.data() + 3, [](double a, double b) { return a > b; });
+    if (s[0] - s[1] < 0.1 || s[1] - s[2] < 0.1) continue;
+    if (coin(rng) < inverted_fraction) s[2] = -s[2];
+    return s;
+  }
 }
 
 // Central finite-difference Jacobian d f / d x (f: R^n -> R^m) with step h.
