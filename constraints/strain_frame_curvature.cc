@@ -1,5 +1,6 @@
 #include "constraints/strain_frame_curvature.h"
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <cmath>
 
@@ -15,17 +16,53 @@ int P(int x, int y) { return 3 * x + y; }
 
 bool IsUniform(const Vec3& a) { return a[0] == a[1] && a[1] == a[2]; }
 
+// A linear form over vec(P) with at most four nonzero coefficients: the first-order forms below
+// touch one or two entries of P, and a's gradient is the sum of two of them. Kept sparse because
+// the quadratic forms built from them are the frame curvature's main cost (docs/solver.md).
+struct SparseForm {
+  int size = 0;
+  int index[4] = {0, 0, 0, 0};
+  double value[4] = {0.0, 0.0, 0.0, 0.0};
+
+  void Add(int i, double v) {
+    for (int k = 0; k < size; ++k)
+      if (index[k] == i) {
+        value[k] += v;
+        return;
+      }
+    TAUT_ASSERT(size < 4);
+    index[size] = i;
+    value[size++] = v;
+  }
+  // this += w b.
+  void AddScaled(double w, const SparseForm& b) {
+    for (int k = 0; k < b.size; ++k) Add(b.index[k], w * b.value[k]);
+  }
+};
+
 // (C1)_xy = s_x P_xy + s_y P_yx as a linear form over vec(P).
-Vec9 FirstOrderForm(const Vec3& s, int x, int y) {
-  Vec9 form = Vec9::Zero();
-  form[P(x, y)] += s[x];
-  form[P(y, x)] += s[y];
+SparseForm FirstOrderForm(const Vec3& s, int x, int y) {
+  SparseForm form;
+  form.Add(P(x, y), s[x]);
+  form.Add(P(y, x), s[y]);
   return form;
 }
 
-// The quadratic form (a . p)(b . p) as a symmetric matrix: (a b^T + b a^T) / 2.
-Mat9 SymmetricProduct(const Vec9& a, const Vec9& b) {
-  return 0.5 * (a * b.transpose() + b * a.transpose());
+SparseForm UnitForm(int index) {
+  SparseForm form;
+  form.Add(index, 1.0);
+  return form;
+}
+
+// H += w (a . p)(b . p) as a symmetric matrix: w (a b^T + b a^T) / 2.
+void AddSymmetricProduct(double w, const SparseForm& a, const SparseForm& b, Mat9& H) {
+  const double half_w = 0.5 * w;
+  for (int p = 0; p < a.size; ++p)
+    for (int q = 0; q < b.size; ++q) {
+      const double t = half_w * a.value[p] * b.value[q];
+      H(a.index[p], b.index[q]) += t;
+      H(b.index[q], a.index[p]) += t;
+    }
 }
 
 // d with |d| raised to at least rho, keeping its sign (sgn(0) := +1; docs/math.md §2 R1).
@@ -41,12 +78,13 @@ Mat9 CalcStretchHessian(const Vec3& s, int i, double gap_epsilon) {
   for (int j = 0; j < 3; ++j) {
     if (j == i) continue;
     const double rho = gap_epsilon / (std::abs(s[i]) + std::abs(s[j]));
-    Vec9 symmetric = Vec9::Zero(), antisymmetric = Vec9::Zero();
-    symmetric[P(i, j)] = symmetric[P(j, i)] = kInvSqrt2;
-    antisymmetric[P(i, j)] = kInvSqrt2;
-    antisymmetric[P(j, i)] = -kInvSqrt2;
-    H.noalias() += (1.0 / ClampGap(s[i] - s[j], rho)) * symmetric * symmetric.transpose();
-    H.noalias() += (1.0 / ClampGap(s[i] + s[j], rho)) * antisymmetric * antisymmetric.transpose();
+    SparseForm symmetric, antisymmetric;
+    symmetric.Add(P(i, j), kInvSqrt2);
+    symmetric.Add(P(j, i), kInvSqrt2);
+    antisymmetric.Add(P(i, j), kInvSqrt2);
+    antisymmetric.Add(P(j, i), -kInvSqrt2);
+    AddSymmetricProduct(1.0 / ClampGap(s[i] - s[j], rho), symmetric, symmetric, H);
+    AddSymmetricProduct(1.0 / ClampGap(s[i] + s[j], rho), antisymmetric, antisymmetric, H);
   }
   return H;
 }
@@ -54,7 +92,7 @@ Mat9 CalcStretchHessian(const Vec3& s, int i, double gap_epsilon) {
 // d^2 a over vec(P) and da, for a = sqrt(v_i^T M v_i), M~ = V^T M V (see the header).
 struct FrameFactorDerivatives {
   double a = 0.0;
-  Vec9 gradient = Vec9::Zero();
+  SparseForm gradient;
   Mat9 hessian = Mat9::Zero();
 };
 
@@ -67,36 +105,37 @@ FrameFactorDerivatives CalcFrameFactorDerivatives(const Vec3& s, int i, const Ma
   Vec3 g = Vec3::Zero();
   for (int j = 0; j < 3; ++j)
     if (j != i) g[j] = 1.0 / CalcClampedGapDenominator(s, i, j, gap_epsilon);
-  // l[x][y] = (C1)_xy; v'_j = g_j l[j][i] for j != i.
-  Vec9 l[3][3];
-  for (int x = 0; x < 3; ++x)
-    for (int y = 0; y < 3; ++y) l[x][y] = FirstOrderForm(s, x, y);
-  Vec9 dv[3];
-  for (int j = 0; j < 3; ++j) dv[j] = j == i ? Vec9::Zero() : Vec9(g[j] * l[j][i]);
+  // v'_j = g_j (C1)_ji for j != i.
+  SparseForm dv[3];
+  for (int j = 0; j < 3; ++j)
+    if (j != i) dv[j].AddScaled(g[j], FirstOrderForm(s, j, i));
   // a' = (M~ v')_i / a.
-  for (int j = 0; j < 3; ++j) out.gradient += (M_tilde(i, j) / out.a) * dv[j];
+  for (int j = 0; j < 3; ++j) out.gradient.AddScaled(M_tilde(i, j) / out.a, dv[j]);
   // v'^T M~ v'.
-  Mat9 q = Mat9::Zero();
+  Mat9& q = out.hessian;
   for (int j = 0; j < 3; ++j)
     for (int k = 0; k < 3; ++k)
-      if (j != i && k != i) q.noalias() += M_tilde(j, k) * SymmetricProduct(dv[j], dv[k]);
-  // (M~ e_i) . v''.
+      if (j != i && k != i) AddSymmetricProduct(M_tilde(j, k), dv[j], dv[k], q);
+  // (M~ e_i) . v'', v''_j = -2 g_j^2 (C1)_ii (C1)_ji + 2 g_j sum_k g_k (C1)_jk (C1)_ki
+  // + g_j (C2)_ji, and the normalization's -M~_ii g_j^2 ((C1)_ji)^2.
+  const SparseForm l_ii = FirstOrderForm(s, i, i);
   for (int j = 0; j < 3; ++j) {
     if (j == i) continue;
-    Mat9 second = -2.0 * g[j] * g[j] * SymmetricProduct(l[i][i], l[j][i]);
+    const double w = M_tilde(j, i);
+    const SparseForm l_ji = FirstOrderForm(s, j, i);
+    AddSymmetricProduct(-2.0 * w * g[j] * g[j], l_ii, l_ji, q);
     for (int k = 0; k < 3; ++k)
-      if (k != i) second.noalias() += 2.0 * g[j] * g[k] * SymmetricProduct(l[j][k], l[k][i]);
+      if (k != i)
+        AddSymmetricProduct(2.0 * w * g[j] * g[k], FirstOrderForm(s, j, k), FirstOrderForm(s, k, i),
+                            q);
     // (C2)_ji = 2 sum_r P_rj P_ri.
-    for (int r = 0; r < 3; ++r) {
-      Vec9 e_rj = Vec9::Zero(), e_ri = Vec9::Zero();
-      e_rj[P(r, j)] = 1.0;
-      e_ri[P(r, i)] = 1.0;
-      second.noalias() += 2.0 * g[j] * SymmetricProduct(e_rj, e_ri);
-    }
-    q.noalias() += M_tilde(j, i) * second;
-    q.noalias() -= M_tilde(i, i) * g[j] * g[j] * l[j][i] * l[j][i].transpose();
+    for (int r = 0; r < 3; ++r)
+      AddSymmetricProduct(2.0 * w * g[j], UnitForm(P(r, j)), UnitForm(P(r, i)), q);
+    AddSymmetricProduct(-M_tilde(i, i) * g[j] * g[j], l_ji, l_ji, q);
   }
-  out.hessian = q / out.a - out.gradient * out.gradient.transpose() / out.a;
+  // d^2 a = (q - a' a'^T) / a.
+  AddSymmetricProduct(-1.0, out.gradient, out.gradient, q);
+  q /= out.a;
   return out;
 }
 
@@ -131,14 +170,21 @@ Mat9 CalcPrincipalStrainRowCurvature(const SignedSvd& svd, const Mat3& Q,
       CalcFrameFactorDerivatives(svd.s, i, M_tilde, params.svd_gap_epsilon);
   if (!(a.a > 0.0)) return Mat9::Zero();
   // -d^2 C = sigma [a d^2 s_i + 2 ds_i da + (s_i - 1) d^2 a], ds_i = P_ii.
-  Vec9 ds = Vec9::Zero();
-  ds[P(i, i)] = 1.0;
-  const Mat9 H = a.a * CalcStretchHessian(svd.s, i, params.svd_gap_epsilon) +
-                 2.0 * SymmetricProduct(ds, a.gradient) + (svd.s[i] - 1.0) * a.hessian;
+  Mat9 H =
+      a.a * CalcStretchHessian(svd.s, i, params.svd_gap_epsilon) + (svd.s[i] - 1.0) * a.hessian;
+  AddSymmetricProduct(2.0, UnitForm(P(i, i)), a.gradient, H);
   return sigma * H;
 }
 
 Mat9 ClampNegativeModes(const Mat9& H) {
+  // Most elements' sums are already PSD: a Cholesky factor of H + delta I (9^3/3 flops, a tenth
+  // of the eigen-decomposition) proves lambda_min(H) > -delta, and H is kept as it is (its
+  // eigenvalues in (-delta, 0) are left unclamped: a change of delta = 1e-10 max |H_kk|).
+  const double delta = 1e-10 * H.diagonal().cwiseAbs().maxCoeff();
+  if (delta > 0.0) {
+    const Eigen::LLT<Mat9> cholesky(H + delta * Mat9::Identity());
+    if (cholesky.info() == Eigen::Success) return H;
+  }
   const Eigen::SelfAdjointEigenSolver<Mat9> eigen(H);
   const Vec9 clamped = eigen.eigenvalues().cwiseMax(0.0);
   return eigen.eigenvectors() * clamped.asDiagonal() * eigen.eigenvectors().transpose();

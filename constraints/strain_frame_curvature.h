@@ -33,7 +33,8 @@ bool HasStrainFrameCurvature(const StrainLimitParams& params);
 Mat9 CalcPrincipalStrainRowCurvature(const SignedSvd& svd, const Mat3& Q,
                                      const StrainLimitParams& params, const StrainLimitKey& key);
 
-// The positive semi-definite part of a symmetric 9x9 matrix (negative eigenvalues set to 0).
+// The positive semi-definite part of a symmetric 9x9 matrix (negative eigenvalues set to 0); a
+// matrix whose eigenvalues are all above -1e-10 max |H_kk| is returned as it is.
 Mat9 ClampNegativeModes(const Mat9& H);
 
 // H over vec(P) mapped to the 12 node coordinates of a tet: P = sum_n (U^T dx_n)(V^T r_n)^T.

@@ -209,6 +209,18 @@ TEST(StrainFrameCurvatureClampTest, KeepsThePositivePartOnly) {
     EXPECT_LT(of_rest.eigenvalues().maxCoeff(), 1e-12);      // only negative modes removed
     const Mat9 psd = A * A.transpose();
     EXPECT_LT((ClampNegativeModes(psd) - psd).cwiseAbs().maxCoeff(), 1e-10 * psd.norm());
+    // Rank 4 (five zero modes) and one mode just below zero: both kept by the Cholesky screen;
+    // a mode at -1e-6 of the scale is clamped.
+    const Eigen::Matrix<double, 9, 4> B = A.leftCols<4>();
+    const Mat9 rank4 = B * B.transpose();
+    EXPECT_TRUE(ClampNegativeModes(rank4) == rank4);
+    const Eigen::Matrix<double, 9, 1> u = A.col(5).normalized();
+    const double scale = rank4.diagonal().maxCoeff();
+    const Mat9 slightly = rank4 - 1e-12 * scale * u * u.transpose();
+    EXPECT_TRUE(ClampNegativeModes(slightly) == slightly);
+    const Mat9 negative = rank4 - 1e-6 * scale * u * u.transpose();
+    const Eigen::SelfAdjointEigenSolver<Mat9> of_negative(ClampNegativeModes(negative));
+    EXPECT_GT(of_negative.eigenvalues().minCoeff(), -1e-12 * scale);
   }
 }
 
