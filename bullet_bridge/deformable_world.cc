@@ -1,6 +1,7 @@
 #include "bullet_bridge/deformable_world.h"
 
 #include <BulletCollision/CollisionDispatch/btCollisionDispatcher.h>
+#include <BulletCollision/CollisionShapes/btCompoundShape.h>
 #include <BulletCollision/CollisionShapes/btPolyhedralConvexShape.h>
 #include <BulletDynamics/Dynamics/btRigidBody.h>
 
@@ -11,6 +12,7 @@
 #include "bullet_bridge/body_pose.h"
 #include "bullet_bridge/collision_filter.h"
 #include "bullet_bridge/eigen_bullet.h"
+#include "plugin/cholmod_cholesky.h"
 #include "plugin/tet_element_model.h"
 
 namespace taut {
@@ -207,6 +209,14 @@ void DeformableWorld::SetContactSurface(DeformableBody* body, const SurfaceMesh&
 
 void DeformableWorld::ClearLimits(DeformableBody* body) { FindEntry(body).sources.clear(); }
 
+void DeformableWorld::SetThreadCount(int num_threads) {
+  TAUT_DEMAND(num_threads >= 1, "DeformableWorld::SetThreadCount: thread count must be >= 1, got ",
+              num_threads);
+  if (num_threads == thread_count()) return;
+  pool_.reset();  // joins the old workers first
+  if (num_threads > 1) pool_ = std::make_unique<IslandThreadPool>(num_threads);
+}
+
 void DeformableWorld::RemoveDeformableBody(DeformableBody* body) {
   auto it = std::find_if(bodies_.begin(), bodies_.end(),
                          [body](const auto& entry) { return &entry->body() == body; });
@@ -236,7 +246,11 @@ void DeformableWorld::internalSingleStepSimulation(btScalar h) {
   const auto start = std::chrono::steady_clock::now();
   btDiscreteDynamicsWorld::internalSingleStepSimulation(h);  // calls solveConstraints below
   stats_.ms_total = MsSince(start);
-  stats_.ms_rigid = stats_.ms_total - stats_.ms_unconstrained - stats_.ms_rows - stats_.ms_solve -
+  // From the stages' wall times: with several threads the islands' ms_rows and ms_solve are
+  // summed over threads and may exceed the time their stage took.
+  stats_.ms_rigid = stats_.ms_total - stats_.ms_unconstrained - stats_.ms_stage_partners -
+                    stats_.ms_stage_islands - stats_.ms_stage_couple_rigid -
+                    stats_.ms_stage_row_sources - stats_.ms_stage_solve_islands -
                     stats_.ms_integrate;
   AddSubstepStats(stats_, call_stats_);
 }
@@ -318,6 +332,16 @@ void DeformableWorld::SumStageStats() {
 void DeformableWorld::BeginDeformableSteps(double h, int& begun) {
   UpdateKinematicAttachments();
   const Vec3 gravity = ToEigen(getGravity());
+  const int num_bodies = static_cast<int>(bodies_.size());
+  if (pool_ != nullptr && num_bodies >= 2 && !IsCholmodAvailable()) {
+    // Safe in parallel: a body's BeginStep writes only that body (state, element model, system
+    // and factor) and reads its rest data, immutable when shared. Not with CHOLMOD: its
+    // factorization switches the process-wide OpenMP setting for the call.
+    begun = num_bodies;  // every body's step runs, also past a failing one
+    auto begin_step = [&](int b) { bodies_[b]->body().BeginStep(h, gravity); };
+    pool_->Run(num_bodies, begin_step);
+    return;
+  }
   for (auto& entry : bodies_) {
     ++begun;
     entry->body().BeginStep(h, gravity);
@@ -508,16 +532,65 @@ void DeformableWorld::SolveRigidIslandsWithBullet(btContactSolverInfo& info) {
   btDiscreteDynamicsWorld::solveConstraints(info);
 }
 
-void DeformableWorld::SolveIslands(double h) {
-  for (int i = 0; i < islands_.num_islands(); ++i) {
-    Island& island = islands_.island(i);
-    if (island.sources.empty()) continue;
-    StepStats island_stats;
-    bodies_[island.first_deformable]->solver.Solve(h, island.bodies, island.sources,
-                                                   solver_settings_, island_stats);
-    AddIslandStats(island_stats, stats_);
-    stats_.islands++;
+namespace {
+// True when `shape` is or holds a GImpact shape, whose triangle queries lock it (they write it).
+bool HasGImpactShape(const btCollisionShape& shape) {
+  if (shape.getShapeType() == GIMPACT_SHAPE_PROXYTYPE) return true;
+  if (shape.getShapeType() != COMPOUND_SHAPE_PROXYTYPE) return false;
+  const auto& compound = static_cast<const btCompoundShape&>(shape);
+  for (int i = 0; i < compound.getNumChildShapes(); ++i)
+    if (HasGImpactShape(*compound.getChildShape(i))) return true;
+  return false;
+}
+}  // namespace
+
+bool DeformableWorld::CanSolveIslandsInParallel() const {
+  if (pool_ == nullptr || solved_islands_.size() < 2) return false;
+  for (const auto& entry : bodies_) {
+    if (entry->object->body().system().uses_cholmod()) return false;  // see BeginDeformableSteps
+    for (const ContactPartner& partner : entry->partners)
+      if (HasGImpactShape(*partner.object->getCollisionShape())) return false;
   }
+  return true;
+}
+
+void DeformableWorld::SolveIslands(double h) {
+  solved_islands_.clear();
+  for (int i = 0; i < islands_.num_islands(); ++i)
+    if (!islands_.island(i).sources.empty()) solved_islands_.push_back(i);
+  const int num_solved = static_cast<int>(solved_islands_.size());
+  island_stats_.assign(num_solved, StepStats());
+  island_done_.assign(num_solved, 0);
+  auto solve = [&](int k) {
+    Island& island = islands_.island(solved_islands_[k]);
+    bodies_[island.first_deformable]->solver.Solve(h, island.bodies, island.sources,
+                                                   solver_settings_, island_stats_[k]);
+    island_done_[k] = 1;
+  };
+  // In island order, up to the first island whose solve threw (as a loop over them would).
+  auto merge_stats = [&] {
+    for (int k = 0; k < num_solved && island_done_[k]; ++k) {
+      AddIslandStats(island_stats_[k], stats_);
+      stats_.islands++;
+    }
+  };
+  try {
+    if (CanSolveIslandsInParallel()) {
+      // Safe in parallel: islands share no deformable and no dynamic rigid body (union-find), and
+      // each has its own solver and sources, whose caches and scratch are theirs. Shared are
+      // only read: static and kinematic partners (transform, shape, friction), rest meshes and
+      // the settings. Bullet's queries from the sources (btGjkEpaSolver2, support mappings,
+      // concave triangle queries) keep their state on the stack; GImpact shapes, which lock
+      // themselves, and CHOLMOD keep the step serial (CanSolveIslandsInParallel).
+      pool_->Run(num_solved, solve);
+    } else {
+      for (int k = 0; k < num_solved; ++k) solve(k);
+    }
+  } catch (...) {
+    merge_stats();
+    throw;
+  }
+  merge_stats();
 }
 
 void DeformableWorld::EndSteps(double h) {

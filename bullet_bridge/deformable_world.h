@@ -12,6 +12,7 @@
 #include "bullet_bridge/contact_report.h"
 #include "bullet_bridge/deformable_collision_object.h"
 #include "bullet_bridge/island_builder.h"
+#include "bullet_bridge/island_thread_pool.h"
 #include "bullet_bridge/joint_source.h"
 #include "bullet_bridge/node_attachment_source.h"
 #include "bullet_bridge/rigid_contact_source.h"
@@ -101,6 +102,17 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   // Solver settings used by every constrained body.
   SqpSettings& mutable_solver_settings() { return solver_settings_; }
   const SqpSettings& solver_settings() const { return solver_settings_; }
+  // Threads that step the deformables (default 1: everything on the caller's thread). With n > 1
+  // a pool of n - 1 persistent worker threads and the caller run the bodies' unconstrained steps
+  // (stage 2) and the independent islands' solves (stage 6) side by side; every result is bitwise
+  // the one of 1 thread (each task writes only its own body or island; statistics are merged in
+  // island order). Stays serial where sharing is not safe: in builds with CHOLMOD (its
+  // factorization switches the process's OpenMP setting) and while a deformable touches a GImpact
+  // shape (its triangle queries lock the shape). After a SimulationError the world is at the step
+  // start either way, but with n > 1 the islands and bodies after the failing one have run their
+  // part of the step: their warm starts are this step's. Throws InputError unless n >= 1.
+  void SetThreadCount(int num_threads);
+  int thread_count() const { return pool_ != nullptr ? pool_->num_threads() : 1; }
 
   int num_deformable_bodies() const { return static_cast<int>(bodies_.size()); }
   DeformableBody& deformable_body(int i) { return bodies_[i]->body(); }
@@ -205,6 +217,8 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   void SolveRigidIslandsWithBullet(btContactSolverInfo& info);
   // Stage 6 for the deformable islands: one SQP per island with rows (no rows: no LCP at all).
   void SolveIslands(double h);
+  // True when this step's islands may be solved on several threads (see SetThreadCount).
+  bool CanSolveIslandsInParallel() const;
   // Stage 7: x = x0 + h v; coupled rigid bodies get their solved velocity back.
   void EndSteps(double h);
   // Stage 8: forces out, each solved island's multipliers with their rows' metadata (forces_).
@@ -245,6 +259,12 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   IslandBuilder islands_;                  // this step's islands
   std::vector<RigidIslandBody*> coupled_;  // rigid bodies in deformable islands, this step
   SqpSettings solver_settings_;
+  std::unique_ptr<IslandThreadPool> pool_;  // null: one thread (SetThreadCount)
+  // This step's islands with rows, each one's statistics and whether its solve returned; kept
+  // across steps so that a step allocates nothing here.
+  std::vector<int> solved_islands_;
+  std::vector<StepStats> island_stats_;
+  std::vector<char> island_done_;
   int next_source_id_ = 0;
   btEmptyAlgorithm::CreateFunc empty_algorithm_;
   StepStats stats_;

@@ -28,6 +28,12 @@ taut::IslandSolverKind& SolverChoice() {
   return kind;
 }
 
+// Threads that step the deformables, chosen by --threads (DeformableWorld::SetThreadCount).
+int& ThreadCount() {
+  static int threads = 1;
+  return threads;
+}
+
 // Runs the scene and writes its outputs; returns the process exit code.
 int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::string& out_dir,
              bool vtk, int vtk_every, bool png) {
@@ -36,6 +42,7 @@ int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::strin
   std::unique_ptr<taut::Scene> scene = info.make();
   if (SolverChoice() != taut::IslandSolverKind::kAuto)
     scene->world().mutable_solver_settings().solver = SolverChoice();
+  scene->world().SetThreadCount(ThreadCount());
   std::ofstream csv(out_dir + "/steps.csv");
   csv.precision(17);
   csv << "step,time_s,ms_step,ms_unconstrained,ms_rows,ms_solve,ms_rigid,rows_strain,"
@@ -164,6 +171,10 @@ int main(int argc, char** argv) {
                  "Island solver: auto (per island by rows per DOF), dual (the papers' PGS) or "
                  "primal (augmented-Lagrangian Newton)")
       ->transform(CLI::CheckedTransformer(solvers, CLI::ignore_case));
+  app.add_option("--threads", ThreadCount(),
+                 "Threads stepping the bodies and independent islands, >= 1 (default 1; results "
+                 "are the same for any count)")
+      ->check(CLI::PositiveNumber);
   CLI11_PARSE(app, argc, argv);
   try {
     if (list) {

@@ -95,6 +95,15 @@ taut_build_asan() {
     -DTAUT_BUILD_BENCH=OFF -DTAUT_BUILD_DEMOS=OFF -DTAUT_UNITY_TESTS=ON
 }
 
+# Debug build with ThreadSanitizer in build/tsan, test binary only (flags as taut_build_asan): the
+# check of DeformableWorld::SetThreadCount's island and body tasks (opt-in, not part of CI).
+taut_build_tsan_tests() {
+  taut_configure build/tsan -DCMAKE_BUILD_TYPE=Debug "-DCMAKE_CXX_FLAGS_DEBUG=-g1 -O1" \
+    -DTAUT_SANITIZE_THREAD=ON -DTAUT_BUILD_BENCH=OFF -DTAUT_BUILD_DEMOS=OFF -DTAUT_UNITY_TESTS=ON
+  taut_stage "Building taut_tests in build/tsan (-j${TAUT_JOBS})"
+  cmake --build build/tsan -j"${TAUT_JOBS}" --target taut_tests
+}
+
 if [[ "${BASH_SOURCE[0]}" == "$0" ]]; then
   set -euo pipefail
   cd "${TAUT_ROOT}"

@@ -6,9 +6,11 @@
 # against the installed package, (3) Debug ASan/UBSan build + ctest, (4) a 10 s
 # libFuzzer run of every mesh reader, (5) the opt-in CHOLMOD build (-DTAUT_WITH_CHOLMOD=ON,
 # build/cholmod, test binary only) and its solver tests.
-#   scripts/run_tests.sh [--quick | --sanitize-only]
-#     --quick          stages 1-2 only (skip the sanitizer build, the fuzz smoke and CHOLMOD)
-#     --sanitize-only  stages 3-4 only
+#   scripts/run_tests.sh [--quick | --sanitize-only | --thread-sanitizer]
+#     --quick             stages 1-2 only (skip the sanitizer build, the fuzz smoke and CHOLMOD)
+#     --sanitize-only     stages 3-4 only
+#     --thread-sanitizer  only the opt-in ThreadSanitizer build (build/tsan, ~25 CPU-minutes to
+#                         compile, so not in CI) and its multi-threaded stepping tests
 # Ends with one line giving each stage's wall time; exits non-zero on any failure.
 set -euo pipefail
 # shellcheck source-path=SCRIPTDIR source=build.sh
@@ -18,15 +20,22 @@ cd "${TAUT_ROOT}"
 run_release=1
 run_consumer=1
 run_asan=1
+run_tsan=0
 for arg in "$@"; do
   case "${arg}" in
     --quick) run_asan=0 ;;
+    --thread-sanitizer)
+      run_release=0
+      run_consumer=0
+      run_asan=0
+      run_tsan=1
+      ;;
     --sanitize-only)
       run_release=0
       run_consumer=0
       ;;
     -h | --help)
-      sed -n '2,11p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
+      sed -n '2,13p' "${BASH_SOURCE[0]}" | sed 's/^# \{0,1\}//'
       exit 0
       ;;
     *)
@@ -35,7 +44,7 @@ for arg in "$@"; do
       ;;
   esac
 done
-if ((run_asan == 0 && run_release == 0)); then
+if ((run_asan == 0 && run_release == 0 && run_tsan == 0)); then
   echo "error: --quick and --sanitize-only together leave nothing to run" >&2
   exit 2
 fi
@@ -124,6 +133,15 @@ stage_asan() {
     -E "${asan_long_tests}"
 }
 
+# Opt-in: a Debug ThreadSanitizer build and the tests that step worlds on several threads.
+stage_tsan() {
+  taut_build_tsan_tests
+  taut_stage "ctest --test-dir build/tsan (multi-threaded stepping tests)"
+  TSAN_OPTIONS="${TSAN_OPTIONS:-halt_on_error=1}" \
+    ctest --test-dir build/tsan --output-on-failure --no-tests=error -j"${TAUT_JOBS}" \
+    -R 'ParallelIslands|IslandThreadPool'
+}
+
 timings=()
 current=""
 current_start=0
@@ -174,4 +192,5 @@ if ((run_consumer)); then run_stage consumer; fi
 if ((run_asan)); then run_stage asan; fi
 if ((run_asan)); then run_stage fuzz; fi
 if ((run_asan && run_release)); then run_stage cholmod; fi
+if ((run_tsan)); then run_stage tsan; fi
 taut_stage "All stages passed"

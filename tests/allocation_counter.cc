@@ -1,6 +1,6 @@
 // The test binary's only replacements of the global allocation functions. operator new (every
-// form) is always counted; malloc/calloc/realloc too on glibc without AddressSanitizer, because
-// Eigen allocates through malloc.
+// form) is always counted; malloc/calloc/realloc too where TAUT_TESTS_COUNT_MALLOC says so,
+// because Eigen allocates through malloc.
 #include "tests/allocation_counter.h"
 
 #include <atomic>
@@ -51,7 +51,7 @@ void operator delete[](void* p, std::align_val_t) noexcept { std::free(p); }
 void operator delete(void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
 void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { std::free(p); }
 
-#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__)
+#if TAUT_TESTS_COUNT_MALLOC
 extern "C" {
 void* __libc_malloc(std::size_t);
 void* __libc_calloc(std::size_t, std::size_t);

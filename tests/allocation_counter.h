@@ -5,6 +5,14 @@
 
 #include <cstddef>
 
+// 1 when malloc/calloc/realloc are counted as well as operator new: on glibc, except under
+// Address- or ThreadSanitizer, whose runtimes own malloc and call it before they are initialized.
+#if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__) && !defined(__SANITIZE_THREAD__)
+#define TAUT_TESTS_COUNT_MALLOC 1
+#else
+#define TAUT_TESTS_COUNT_MALLOC 0
+#endif
+
 namespace taut::testing {
 
 // Number of operator new calls made by this thread since the program started.
