@@ -139,27 +139,32 @@ void DeformableBody::BeginStep(double h, const Vec3& gravity) {
   const double c_M = 1.0 + h * settings_.mass_damping;
   const double c_K = h * settings_.stiffness_damping + h * h;
   system_.Assemble(*model_, mass_, c_M, c_K);
-  try {
-    system_.Factor(name());
-  } catch (const SimulationError&) {
-    external_.setZero();  // x, v are still the step start's
-    throw;
-  }
   for (int i = 0; i < num_nodes(); ++i)
     v_star_.segment<3>(3 * i) = mass_[i] * v0_.segment<3>(3 * i) + h * force_.segment<3>(3 * i);
   scratch_.setZero();
   model_->AddScaledStiffnessTimes(c_K, kinematic_v_, scratch_);
   v_star_ -= scratch_;
-  system_.Solve(v_star_);
+  try {
+    last_pcg_iterations_ = system_.SolveStep(v_star_, name(), settings_.factor_reuse);
+  } catch (const SimulationError&) {
+    external_.setZero();  // x, v are still the step start's
+    throw;
+  }
   v_star_ += kinematic_v_;
   v_ = v_star_;
   CheckVelocities("unconstrained solve");
   external_.setZero();
 }
 
-void DeformableBody::SolveSystem(Eigen::Ref<VecX> rhs) const { system_.Solve(rhs); }
+void DeformableBody::SolveSystem(Eigen::Ref<VecX> rhs) {
+  system_.EnsureCurrentFactor(name());
+  system_.Solve(rhs);
+}
 
-void DeformableBody::SolveSystemColumns(Eigen::Ref<MatX> rhs) const { system_.SolveColumns(rhs); }
+void DeformableBody::SolveSystemColumns(Eigen::Ref<MatX> rhs) {
+  system_.EnsureCurrentFactor(name());
+  system_.SolveColumns(rhs);
+}
 
 void DeformableBody::EndStep(double h) {
   CheckVelocities("end of step");

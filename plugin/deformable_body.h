@@ -17,7 +17,8 @@ namespace taut {
 // Runtime deformable body. Positions x and velocities v are 3N vectors (node-major xyz).
 // One step h, split into stages so constraint solvers can act between them:
 //   BeginStep:  A = M + h D + h^2 K,  b = M v0 + h f(x0)  (forces linearized at the step start,
-//               D = alpha M + beta K), factor A, v* = A^-1 b, set v = v*;
+//               D = alpha M + beta K), v* = A^-1 b (factoring A, or by CG on a kept
+//               factor: settings.factor_reuse), set v = v*;
 //   (constraints change v by A^-1 J^T lambda, using SolveSystem);
 //   EndStep:    x = x0 + h v.
 // Stage-boundary guards (after force assembly, after the unconstrained solve, at EndStep) throw
@@ -92,10 +93,14 @@ class DeformableBody {
   // Throws InputError when h is not finite and > 0 or gravity is not finite, SimulationError
   // (state kept at the step start) on a non-finite force, a singular system or an exploding v*.
   void BeginStep(double h, const Vec3& gravity);
-  // rhs <- A^-1 rhs on free DOFs, zero on fixed/kinematic DOFs (rhs is 3N).
-  void SolveSystem(Eigen::Ref<VecX> rhs) const;
+  // rhs <- A^-1 rhs on free DOFs, zero on fixed/kinematic DOFs (rhs is 3N). Factors this step's
+  // A first if the unconstrained solve reused an earlier factor (ImplicitSystem::SolveStep);
+  // throws SimulationError naming the body if A is not positive definite.
+  void SolveSystem(Eigen::Ref<VecX> rhs);
   // Same for every column of a 3N x k matrix.
-  void SolveSystemColumns(Eigen::Ref<MatX> rhs) const;
+  void SolveSystemColumns(Eigen::Ref<MatX> rhs);
+  // PCG iterations of the last unconstrained solve on a kept factor; 0 when it factored A.
+  int last_pcg_iterations() const { return last_pcg_iterations_; }
   // out = A v with this step's system matrix (free DOFs; 0 on fixed/kinematic DOFs).
   void ApplySystemMatrix(const VecX& v, VecX& out) const { system_.Multiply(v, out); }
   // Stage 7: x = x0 + h v. Throws SimulationError (keeping the step-start state) on NaN/Inf in
@@ -154,6 +159,7 @@ class DeformableBody {
   std::vector<NodeKind> kinds_;
   std::vector<Vec3> kinematic_targets_;
   ImplicitSystem system_;
+  int last_pcg_iterations_ = 0;  // of the last BeginStep (SolveStep)
   bool kinds_changed_ = true;
 };
 

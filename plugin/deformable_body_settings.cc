@@ -21,6 +21,11 @@ void DeformableBodySettings::Validate() const {
               "': restitution must be in [0, 1], got ", restitution);
   TAUT_DEMAND(!std::isnan(max_speed) && max_speed > 0.0, "body '", name,
               "': max speed must be > 0 m/s (+inf disables the check), got ", max_speed);
+  TAUT_DEMAND(std::isfinite(factor_reuse.min_refactor_cost) && factor_reuse.min_refactor_cost > 0.0,
+              "body '", name, "': factor_reuse.min_refactor_cost must be finite and > 0, got ",
+              factor_reuse.min_refactor_cost);
+  TAUT_DEMAND(factor_reuse.pcg_tolerance > 0.0 && factor_reuse.pcg_tolerance < 1.0, "body '", name,
+              "': factor_reuse.pcg_tolerance must be in (0, 1), got ", factor_reuse.pcg_tolerance);
 }
 
 }  // namespace taut

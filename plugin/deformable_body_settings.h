@@ -7,6 +7,16 @@
 
 namespace taut {
 
+// Factor reuse in a body's unconstrained solve (ImplicitSystem::SolveStep, docs/solver.md): a
+// body whose factorization of A costs at least min_refactor_cost PCG iterations solves the next
+// steps by CG preconditioned with the last factor, to a relative residual of pcg_tolerance, and
+// refactors when CG needs more than half that cost or the constraint solve needs A^-1.
+struct FactorReuseSettings {
+  bool enabled = true;
+  double min_refactor_cost = 8.0;  // > 0
+  double pcg_tolerance = 1e-10;    // in (0, 1)
+};
+
 // Material, damping and identity of one deformable body.
 struct DeformableBodySettings {
   std::string name = "body";       // used in error messages and reports
@@ -31,6 +41,7 @@ struct DeformableBodySettings {
   // [m/s] > 0 (+inf disables): a free node faster than this after the unconstrained solve or at
   // the end of a step counts as an explosion; the step throws SimulationError. Default 1e3 m/s.
   double max_speed = 1e3;
+  FactorReuseSettings factor_reuse;  // of the unconstrained solve (validated)
   // Throws InputError naming the body and the quantity when out of range.
   void Validate() const;
 };

@@ -68,7 +68,11 @@ void ImplicitSystem::Build(const ElementModel& model, const std::vector<NodeKind
   if (n > 0 && !use_cholmod_) ldlt_.Analyze(A_);
   rhs_free_.resize(n);
   product_free_.resize(n);
+  for (VecX* v : {&cg_r_, &cg_z_, &cg_p_, &cg_ap_, &cg_x_}) v->resize(n);
   newton_analyzed_ = false;
+  factor_current_ = false;
+  exact_solves_ = false;
+  refactor_next_ = false;
 }
 
 void ImplicitSystem::Assemble(const ElementModel& model, const VecX& mass, double c_M, double c_K) {
@@ -76,6 +80,7 @@ void ImplicitSystem::Assemble(const ElementModel& model, const VecX& mass, doubl
   std::fill(values, values + A_.nonZeros(), 0.0);
   for (int i = 0; i < num_free_dofs(); ++i) values[diagonal_[i]] += c_M * mass[free_to_dof_[i] / 3];
   model.AddScaledStiffness(c_K, element_map_, values);
+  factor_current_ = false;
 }
 
 bool ImplicitSystem::FactorWith(const Eigen::SparseMatrix<double>& M, SparseLdlt& ldlt,
@@ -106,14 +111,84 @@ void ImplicitSystem::MultiplyWith(const Eigen::SparseMatrix<double>& M, const Ve
 }
 
 void ImplicitSystem::Factor(const std::string& body) {
+  factor_current_ = false;
   if (num_free_dofs() == 0) return;
   if (!FactorWith(A_, ldlt_, cholmod_))
     throw SimulationError(internal::Concat("body '", body,
                                            "': system matrix A = M + hD + h^2 K is not positive "
                                            "definite (stage: factorization)"));
+  factor_current_ = true;
 }
 
-void ImplicitSystem::Solve(Eigen::Ref<VecX> rhs) const { SolveWith(ldlt_, cholmod_, rhs); }
+int ImplicitSystem::SolveStep(Eigen::Ref<VecX> rhs, const std::string& body,
+                              const FactorReuseSettings& reuse) {
+  const double cost = CalcRefactorCost(ldlt_);
+  const bool try_kept = reuse.enabled && !use_cholmod_ && !exact_solves_ && !refactor_next_ &&
+                        ldlt_.factorized() && cost >= reuse.min_refactor_cost;
+  exact_solves_ = false;
+  refactor_next_ = false;
+  if (try_kept) {
+    const int n = num_free_dofs();
+    for (int i = 0; i < n; ++i) cg_x_[i] = rhs[free_to_dof_[i]];
+    const int iterations =
+        SolveByKeptFactor(cg_x_, reuse.pcg_tolerance, static_cast<int>(cost));
+    if (iterations >= 0) {
+      rhs.setZero();
+      for (int i = 0; i < n; ++i) rhs[free_to_dof_[i]] = cg_x_[i];
+      return iterations;
+    }
+    // Out of budget: this step factors (below), and so does the next.
+  }
+  Factor(body);
+  Solve(rhs);
+  return 0;
+}
+
+int ImplicitSystem::SolveByKeptFactor(VecX& b_then_x, double tolerance, int max_iterations) const {
+  // Preconditioned CG (Saad, Iterative Methods, Alg. 9.1) with P = the kept L D L^T of an earlier
+  // A, from x_0 = P^-1 b.
+  cg_r_ = b_then_x;  // r = b
+  const double threshold = tolerance * b_then_x.norm();
+  if (threshold == 0.0) return 0;  // b = 0: x = 0
+  ldlt_.Solve(b_then_x);           // x_0 = P^-1 b
+  int applications = 1;
+  cg_ap_.noalias() = A_ * b_then_x;
+  cg_r_ -= cg_ap_;
+  double rz_old = 0.0;
+  while (cg_r_.norm() > threshold) {
+    if (applications >= max_iterations) return -1;
+    cg_z_ = cg_r_;
+    ldlt_.Solve(cg_z_);  // z = P^-1 r
+    ++applications;
+    const double rz = cg_r_.dot(cg_z_);
+    if (applications == 2)
+      cg_p_ = cg_z_;
+    else
+      cg_p_ = cg_z_ + (rz / rz_old) * cg_p_;
+    rz_old = rz;
+    cg_ap_.noalias() = A_ * cg_p_;
+    const double alpha = rz / cg_p_.dot(cg_ap_);
+    b_then_x += alpha * cg_p_;
+    cg_r_ -= alpha * cg_ap_;
+  }
+  return applications;
+}
+
+void ImplicitSystem::EnsureCurrentFactor(const std::string& body) {
+  exact_solves_ = true;
+  if (!factor_current_) Factor(body);
+}
+
+double ImplicitSystem::CalcRefactorCost(const SparseLdlt& factor) const {
+  if (use_cholmod_ || !factor.factorized() || num_free_dofs() == 0) return 0.0;
+  const double iteration = 4.0 * factor.nonzeros_in_L() + 2.0 * A_.nonZeros();
+  return factor.CalcFactorWork() / iteration;
+}
+
+void ImplicitSystem::Solve(Eigen::Ref<VecX> rhs) const {
+  TAUT_ASSERT(factor_current_ || num_free_dofs() == 0);
+  SolveWith(ldlt_, cholmod_, rhs);
+}
 
 void ImplicitSystem::SolveColumns(Eigen::Ref<MatX> rhs) const {
   const int n = num_free_dofs();
@@ -123,6 +198,7 @@ void ImplicitSystem::SolveColumns(Eigen::Ref<MatX> rhs) const {
   for (int i = 0; i < n; ++i) cols.row(i) = rhs.row(free_to_dof_[i]);
   rhs.setZero();
   if (n == 0) return;
+  TAUT_ASSERT(factor_current_);
   if (use_cholmod_)
     cholmod_.SolveColumns(cols);
   else
@@ -203,13 +279,16 @@ bool ImplicitSystem::HasNewtonFactor() const {
 
 double ImplicitSystem::CalcNewtonRefactorCost() const {
   if (!HasNewtonFactor()) return 0.0;
-  const double iteration = 4.0 * newton_ldlt_.nonzeros_in_L() + 2.0 * A_.nonZeros();
-  return newton_ldlt_.CalcFactorWork() / iteration;
+  return CalcRefactorCost(newton_ldlt_);
 }
 
 ImplicitSystem::NewtonState ImplicitSystem::SaveNewtonState() const {
   NewtonState state;
-  if (use_cholmod_ || !newton_analyzed_) return state;
+  if (use_cholmod_) return state;
+  state.system_factor = ldlt_;
+  state.exact_solves = exact_solves_;
+  state.refactor_next = refactor_next_;
+  if (!newton_analyzed_) return state;
   state.analyzed = true;
   state.H = H_;
   state.factor = newton_ldlt_;
@@ -223,9 +302,19 @@ void ImplicitSystem::RestoreNewtonState(const NewtonState& state) {
                 "Newton state of ", state.H.rows(), " free DOFs and ", state.H.nonZeros(),
                 " entries does not fit this system (", num_free_dofs(), " free DOFs, ",
                 A_.nonZeros(), " entries)");
+  const bool factor_fits = state.system_factor.analyzed() &&
+                           state.system_factor.rows() == num_free_dofs() &&
+                           state.system_factor.nonzeros_in_L() == ldlt_.nonzeros_in_L();
+  TAUT_DEMAND(factor_fits || !state.system_factor.analyzed(), "system factor of ",
+              state.system_factor.rows(), " free DOFs does not fit this system (",
+              num_free_dofs(), " free DOFs)");
   newton_analyzed_ = state.analyzed;
   H_ = state.H;
   newton_ldlt_ = state.factor;
+  if (factor_fits) ldlt_ = state.system_factor;
+  factor_current_ = false;  // A is assembled again by the next step
+  exact_solves_ = state.exact_solves;
+  refactor_next_ = state.refactor_next;
 }
 
 }  // namespace taut

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "plugin/cholmod_cholesky.h"
+#include "plugin/deformable_body_settings.h"
 #include "plugin/element_model.h"
 #include "plugin/node_kind.h"
 #include "plugin/sparse_ldlt.h"
@@ -48,7 +49,20 @@ class ImplicitSystem {
   void Assemble(const ElementModel& model, const VecX& mass, double c_M, double c_K);
   // Numeric factorization; throws SimulationError naming `body` if A is not positive definite.
   void Factor(const std::string& body);
-  // rhs (3N) <- A^-1 rhs on free DOFs; constrained DOFs set to 0.
+  // The unconstrained solve of a step, rhs (3N) <- A^-1 rhs, with factor reuse (docs/solver.md,
+  // "Factor reuse in the unconstrained step"): when `reuse` allows it and a factor of an earlier
+  // step's A is held whose refactor costs at least reuse.min_refactor_cost PCG iterations, CG on
+  // this A preconditioned by that factor runs to a relative residual of reuse.pcg_tolerance,
+  // within half that cost; else (also when the last step's constraint solve needed A^-1, see
+  // EnsureCurrentFactor) A is factored and solved directly. Returns the PCG iterations, 0 for
+  // the direct solve. Throws SimulationError naming `body` if A is not positive definite.
+  int SolveStep(Eigen::Ref<VecX> rhs, const std::string& body, const FactorReuseSettings& reuse);
+  // Factors A if the held factor is an earlier step's (SolveStep kept it), so that Solve and
+  // SolveColumns apply this step's A^-1. Throws SimulationError like Factor.
+  void EnsureCurrentFactor(const std::string& body);
+  // True when the held factor is the one of this step's A (Solve and SolveColumns are exact).
+  bool factor_is_current() const { return factor_current_; }
+  // rhs (3N) <- A^-1 rhs on free DOFs; constrained DOFs set to 0. Requires factor_is_current().
   void Solve(Eigen::Ref<VecX> rhs) const;
   // Same for each column of rhs (3N x k).
   void SolveColumns(Eigen::Ref<MatX> rhs) const;
@@ -90,13 +104,17 @@ class ImplicitSystem {
   double CalcNewtonRefactorCost() const;
 
   // The part of the system that outlives a step: the Newton matrix H and its SparseLdlt factor,
-  // which the primal solver's next steps reuse as a preconditioner (factor reuse). Saved by world
-  // snapshots (bullet_bridge/world_snapshot.h) so a restored body continues bit-identically.
-  // With CHOLMOD nothing is kept (its Newton factor is never reused): `analyzed` stays false.
+  // which the primal solver's next steps reuse as a preconditioner (factor reuse), and A's factor,
+  // which the next unconstrained solves may reuse (SolveStep). Saved by world snapshots
+  // (bullet_bridge/world_snapshot.h) so a restored body continues bit-identically. With CHOLMOD
+  // nothing is kept (its factors are never reused): `analyzed` stays false.
   struct NewtonState {
     bool analyzed = false;  // H's pattern and symbolic analysis are set up
     Eigen::SparseMatrix<double> H;
     SparseLdlt factor;
+    SparseLdlt system_factor;      // A's factor of the last step that factored A
+    bool exact_solves = false;     // the last step's constraint solve needed this step's A^-1
+    bool refactor_next = false;    // the last PCG on a kept factor ran out of its budget
   };
   NewtonState SaveNewtonState() const;
   // Puts a saved state back (CHOLMOD: no-op). The system must be built with the node kinds of the
@@ -114,6 +132,17 @@ class ImplicitSystem {
   bool use_cholmod_ = false;
   SparseLdlt ldlt_;          // the factor when !use_cholmod_
   CholmodCholesky cholmod_;  // the factor when use_cholmod_
+  bool factor_current_ = false;  // the factor is of A's values (not an earlier step's A)
+  bool exact_solves_ = false;    // EnsureCurrentFactor was called since the last SolveStep
+  bool refactor_next_ = false;   // the last reuse PCG ran out of budget: factor at the next step
+  // Cost of factoring A in PCG iterations with the held factor (4 nnz(L) + 2 nnz(A) flops each),
+  // 0 without a SparseLdlt factor.
+  double CalcRefactorCost(const SparseLdlt& factor) const;
+  // x = A^-1 b on free DOFs by CG preconditioned with the held (earlier) factor of A, at most
+  // max_iterations preconditioner applications, to ||b - A x|| <= tolerance ||b||. Returns the
+  // applications used, or -1 when the budget ran out (x then unusable).
+  int SolveByKeptFactor(VecX& b_then_x, double tolerance, int max_iterations) const;
+  mutable VecX cg_r_, cg_z_, cg_p_, cg_ap_, cg_x_;  // PCG work vectors (num_free)
   // Numeric factorization of M (A or H, same pattern) into the chosen backend's factor; false
   // when M is not positive definite.
   bool FactorWith(const Eigen::SparseMatrix<double>& M, SparseLdlt& ldlt,

@@ -1,0 +1,119 @@
+// Factor reuse in the unconstrained solve (ImplicitSystem::SolveStep): a body large enough to
+// reuse its factor solves by CG on the kept factor, follows the trajectory of the body that
+// factors every step to the CG tolerance, and still applies this step's exact A^-1 to the
+// constraint solve's right-hand sides.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <memory>
+
+#include "plugin/box_tet_mesher.h"
+#include "plugin/deformable_body.h"
+#include "plugin/tet_element_model.h"
+
+namespace taut {
+namespace {
+
+// A soft 1 x 0.2 x 0.2 m cantilever of 20 x 4 x 4 cubes (1,920 tets), clamped at x = 0: its
+// factorization costs ~11 PCG iterations, above the default min_refactor_cost.
+std::unique_ptr<DeformableBody> MakeCantilever(bool reuse) {
+  DeformableBodySettings settings;
+  settings.name = reuse ? "reusing" : "factoring";
+  settings.material = {1e5, 0.3, 1000.0};
+  settings.factor_reuse.enabled = reuse;
+  auto body = std::make_unique<DeformableBody>(
+      std::make_unique<TetElementModel>(std::make_shared<const TetMesh>(MakeBoxTetMesh(
+                                            Vec3(1.0, 0.2, 0.2), 20, 4, 4, Vec3::Zero())),
+                                        settings.material),
+      settings);
+  body->FixNodesWhere([](const Vec3& x) { return x.x() < 1e-9; });
+  return body;
+}
+
+constexpr double kStep = 1.0 / 240.0;
+const Vec3 kGravity(0.0, 0.0, -9.81);
+
+TEST(FactorReuseTest, ReusingBodyFollowsTheFactoringBodyToTheCgTolerance) {
+  auto reusing = MakeCantilever(true);
+  auto factoring = MakeCantilever(false);
+  reusing->BeginStep(kStep, kGravity);  // builds the system, choosing its backend
+  if (reusing->system().uses_cholmod()) GTEST_SKIP() << "CHOLMOD factors are not reused";
+  reusing = MakeCantilever(true);
+  int reused_steps = 0;
+  for (int step = 0; step < 40; ++step) {
+    reusing->BeginStep(kStep, kGravity);
+    factoring->BeginStep(kStep, kGravity);
+    EXPECT_EQ(factoring->last_pcg_iterations(), 0);
+    if (reusing->last_pcg_iterations() > 0) ++reused_steps;
+    reusing->EndStep(kStep);
+    factoring->EndStep(kStep);
+  }
+  EXPECT_GE(reused_steps, 30) << "the kept factor was hardly used";
+  // The tip has sagged (the comparison is not of two bodies at rest).
+  const double sag = (factoring->x() - MakeCantilever(false)->x()).cwiseAbs().maxCoeff();
+  ASSERT_GT(sag, 1e-3);
+  const double gap = (reusing->x() - factoring->x()).cwiseAbs().maxCoeff();
+  EXPECT_LT(gap, 1e-6 * sag) << "sag " << sag << " m";
+}
+
+TEST(FactorReuseTest, ConstraintSolvesAfterAReusedStepApplyThisStepsInverse) {
+  auto body = MakeCantilever(true);
+  for (int step = 0; step < 3; ++step) {
+    if (step == 1 && body->system().uses_cholmod()) GTEST_SKIP() << "CHOLMOD is not reused";
+    body->BeginStep(kStep, kGravity);
+    body->EndStep(kStep);
+  }
+  body->BeginStep(kStep, kGravity);
+  ASSERT_GT(body->last_pcg_iterations(), 0);
+  ASSERT_FALSE(body->system().factor_is_current());
+  // A (A^-1 b) = b on the free DOFs to round-off: the solve factored this step's A.
+  VecX b = VecX::Zero(3 * body->num_nodes());
+  for (int i = 0; i < b.size(); ++i)
+    if (body->system().free_index(i) >= 0) b[i] = std::sin(0.37 * i);
+  VecX x = b;
+  body->SolveSystem(x);
+  EXPECT_TRUE(body->system().factor_is_current());
+  VecX Ax;
+  body->ApplySystemMatrix(x, Ax);
+  EXPECT_LT((Ax - b).norm(), 1e-10 * b.norm());
+  // The next step, whose constraint solve is likely to need A^-1 again, factors directly.
+  body->EndStep(kStep);
+  body->BeginStep(kStep, kGravity);
+  EXPECT_EQ(body->last_pcg_iterations(), 0);
+  EXPECT_TRUE(body->system().factor_is_current());
+}
+
+TEST(FactorReuseTest, RestoredStateContinuesBitIdenticallyOnTheKeptFactor) {
+  auto body = MakeCantilever(true);
+  auto run = [&](int steps) {
+    for (int step = 0; step < steps; ++step) {
+      body->BeginStep(kStep, kGravity);
+      body->EndStep(kStep);
+    }
+  };
+  run(5);
+  const DeformableBody::State saved = body->SaveState();
+  run(5);
+  const VecX first = body->x();
+  const int first_iterations = body->last_pcg_iterations();
+  run(7);  // the kept factor moves on
+  body->RestoreState(saved);
+  run(5);
+  EXPECT_EQ(body->last_pcg_iterations(), first_iterations);
+  EXPECT_EQ(0, std::memcmp(first.data(), body->x().data(), sizeof(double) * first.size()));
+}
+
+TEST(FactorReuseTest, OutOfRangeSettingsAreRejected) {
+  DeformableBodySettings settings;
+  settings.factor_reuse.min_refactor_cost = 0.0;
+  EXPECT_THROW(settings.Validate(), InputError);
+  settings.factor_reuse.min_refactor_cost = 8.0;
+  settings.factor_reuse.pcg_tolerance = 1.0;
+  EXPECT_THROW(settings.Validate(), InputError);
+  settings.factor_reuse.pcg_tolerance = 1e-10;
+  EXPECT_NO_THROW(settings.Validate());
+}
+
+}  // namespace
+}  // namespace taut
