@@ -130,8 +130,7 @@ int ImplicitSystem::SolveStep(Eigen::Ref<VecX> rhs, const std::string& body,
   if (try_kept) {
     const int n = num_free_dofs();
     for (int i = 0; i < n; ++i) cg_x_[i] = rhs[free_to_dof_[i]];
-    const int iterations =
-        SolveByKeptFactor(cg_x_, reuse.pcg_tolerance, static_cast<int>(cost));
+    const int iterations = SolveByKeptFactor(cg_x_, reuse.pcg_tolerance, static_cast<int>(cost));
     if (iterations >= 0) {
       rhs.setZero();
       for (int i = 0; i < n; ++i) rhs[free_to_dof_[i]] = cg_x_[i];
@@ -306,8 +305,8 @@ void ImplicitSystem::RestoreNewtonState(const NewtonState& state) {
                            state.system_factor.rows() == num_free_dofs() &&
                            state.system_factor.nonzeros_in_L() == ldlt_.nonzeros_in_L();
   TAUT_DEMAND(factor_fits || !state.system_factor.analyzed(), "system factor of ",
-              state.system_factor.rows(), " free DOFs does not fit this system (",
-              num_free_dofs(), " free DOFs)");
+              state.system_factor.rows(), " free DOFs does not fit this system (", num_free_dofs(),
+              " free DOFs)");
   newton_analyzed_ = state.analyzed;
   H_ = state.H;
   newton_ldlt_ = state.factor;

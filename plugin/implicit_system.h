@@ -112,9 +112,9 @@ class ImplicitSystem {
     bool analyzed = false;  // H's pattern and symbolic analysis are set up
     Eigen::SparseMatrix<double> H;
     SparseLdlt factor;
-    SparseLdlt system_factor;      // A's factor of the last step that factored A
-    bool exact_solves = false;     // the last step's constraint solve needed this step's A^-1
-    bool refactor_next = false;    // the last PCG on a kept factor ran out of its budget
+    SparseLdlt system_factor;    // A's factor of the last step that factored A
+    bool exact_solves = false;   // the last step's constraint solve needed this step's A^-1
+    bool refactor_next = false;  // the last PCG on a kept factor ran out of its budget
   };
   NewtonState SaveNewtonState() const;
   // Puts a saved state back (CHOLMOD: no-op). The system must be built with the node kinds of the
@@ -130,8 +130,8 @@ class ImplicitSystem {
   Eigen::SparseMatrix<double> A_;  // full symmetric, free DOFs
   LinearSolverKind requested_solver_ = LinearSolverKind::kAuto;
   bool use_cholmod_ = false;
-  SparseLdlt ldlt_;          // the factor when !use_cholmod_
-  CholmodCholesky cholmod_;  // the factor when use_cholmod_
+  SparseLdlt ldlt_;              // the factor when !use_cholmod_
+  CholmodCholesky cholmod_;      // the factor when use_cholmod_
   bool factor_current_ = false;  // the factor is of A's values (not an earlier step's A)
   bool exact_solves_ = false;    // EnsureCurrentFactor was called since the last SolveStep
   bool refactor_next_ = false;   // the last reuse PCG ran out of budget: factor at the next step
