@@ -49,10 +49,13 @@ if ((run_asan == 0 && run_release == 0 && run_tsan == 0)); then
   exit 2
 fi
 
-# Runs ctest on a build dir; a suite that finds no tests is a failure, not a pass.
+# Runs ctest on a build dir ($1) with any further ctest arguments (test filters); a suite that
+# finds no tests is a failure, not a pass.
 run_ctest() {
-  taut_stage "ctest --test-dir $1"
-  ctest --test-dir "$1" --output-on-failure --no-tests=error -j"${TAUT_JOBS}"
+  local dir="$1"
+  shift
+  taut_stage "ctest --test-dir ${dir} $*"
+  ctest --test-dir "${dir}" --output-on-failure --no-tests=error -j"${TAUT_JOBS}" "$@"
 }
 
 # Stage 1: Release build and its tests.
@@ -83,9 +86,7 @@ stage_format() {
 # so CHOLMOD's solves allocate there whatever taut does (an opt-in backend's property, not taut's).
 stage_cholmod() {
   taut_build_cholmod_tests
-  taut_stage "ctest --test-dir build/cholmod (CHOLMOD and solver tests)"
-  ctest --test-dir build/cholmod --output-on-failure --no-tests=error -j"${TAUT_JOBS}" \
-    -R 'Cholmod|LinearSolverChoice|SparseLdlt|ImplicitSystem|Determinism' \
+  run_ctest build/cholmod -R 'Cholmod|LinearSolverChoice|SparseLdlt|ImplicitSystem|Determinism' \
     -E 'SolvesDoNotAllocateButFactorizeDoes'
 }
 
@@ -127,19 +128,15 @@ asan_long_tests+='|CertificateStepsCertifyTheHoldsBetweenPresses|AutoPathLeavesF
 # Stage 3: Debug build with AddressSanitizer + UBSan and its tests (without the long ones above).
 stage_asan() {
   taut_build_asan
-  taut_stage "ctest --test-dir build/asan (without: ${asan_long_tests})"
   UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}" \
-    ctest --test-dir build/asan --output-on-failure --no-tests=error -j"${TAUT_JOBS}" \
-    -E "${asan_long_tests}"
+    run_ctest build/asan -E "${asan_long_tests}"
 }
 
 # Opt-in: a Debug ThreadSanitizer build and the tests that step worlds on several threads.
 stage_tsan() {
   taut_build_tsan_tests
-  taut_stage "ctest --test-dir build/tsan (multi-threaded stepping tests)"
   TSAN_OPTIONS="${TSAN_OPTIONS:-halt_on_error=1}" \
-    ctest --test-dir build/tsan --output-on-failure --no-tests=error -j"${TAUT_JOBS}" \
-    -R 'ParallelIslands|IslandThreadPool'
+    run_ctest build/tsan -R 'ParallelIslands|IslandThreadPool'
 }
 
 timings=()
