@@ -17,7 +17,7 @@ namespace {
 
 // A soft 1 x 0.2 x 0.2 m cantilever of 20 x 4 x 4 cubes (1,920 tets), clamped at x = 0: its
 // factorization costs ~11 PCG iterations, above the default min_refactor_cost.
-std::unique_ptr<DeformableBody> MakeCantilever(bool reuse) {
+std::unique_ptr<DeformableBody> MakeReuseCantilever(bool reuse) {
   DeformableBodySettings settings;
   settings.name = reuse ? "reusing" : "factoring";
   settings.material = {1e5, 0.3, 1000.0};
@@ -31,40 +31,40 @@ std::unique_ptr<DeformableBody> MakeCantilever(bool reuse) {
   return body;
 }
 
-constexpr double kStep = 1.0 / 240.0;
-const Vec3 kGravity(0.0, 0.0, -9.81);
+constexpr double kReuseStep = 1.0 / 240.0;
+const Vec3 kReuseGravity(0.0, 0.0, -9.81);
 
 TEST(FactorReuseTest, ReusingBodyFollowsTheFactoringBodyToTheCgTolerance) {
-  auto reusing = MakeCantilever(true);
-  auto factoring = MakeCantilever(false);
-  reusing->BeginStep(kStep, kGravity);  // builds the system, choosing its backend
+  auto reusing = MakeReuseCantilever(true);
+  auto factoring = MakeReuseCantilever(false);
+  reusing->BeginStep(kReuseStep, kReuseGravity);  // builds the system, choosing its backend
   if (reusing->system().uses_cholmod()) GTEST_SKIP() << "CHOLMOD factors are not reused";
-  reusing = MakeCantilever(true);
+  reusing = MakeReuseCantilever(true);
   int reused_steps = 0;
   for (int step = 0; step < 40; ++step) {
-    reusing->BeginStep(kStep, kGravity);
-    factoring->BeginStep(kStep, kGravity);
+    reusing->BeginStep(kReuseStep, kReuseGravity);
+    factoring->BeginStep(kReuseStep, kReuseGravity);
     EXPECT_EQ(factoring->last_pcg_iterations(), 0);
     if (reusing->last_pcg_iterations() > 0) ++reused_steps;
-    reusing->EndStep(kStep);
-    factoring->EndStep(kStep);
+    reusing->EndStep(kReuseStep);
+    factoring->EndStep(kReuseStep);
   }
   EXPECT_GE(reused_steps, 30) << "the kept factor was hardly used";
   // The tip has sagged (the comparison is not of two bodies at rest).
-  const double sag = (factoring->x() - MakeCantilever(false)->x()).cwiseAbs().maxCoeff();
+  const double sag = (factoring->x() - MakeReuseCantilever(false)->x()).cwiseAbs().maxCoeff();
   ASSERT_GT(sag, 1e-3);
   const double gap = (reusing->x() - factoring->x()).cwiseAbs().maxCoeff();
   EXPECT_LT(gap, 1e-6 * sag) << "sag " << sag << " m";
 }
 
 TEST(FactorReuseTest, ConstraintSolvesAfterAReusedStepApplyThisStepsInverse) {
-  auto body = MakeCantilever(true);
+  auto body = MakeReuseCantilever(true);
   for (int step = 0; step < 3; ++step) {
     if (step == 1 && body->system().uses_cholmod()) GTEST_SKIP() << "CHOLMOD is not reused";
-    body->BeginStep(kStep, kGravity);
-    body->EndStep(kStep);
+    body->BeginStep(kReuseStep, kReuseGravity);
+    body->EndStep(kReuseStep);
   }
-  body->BeginStep(kStep, kGravity);
+  body->BeginStep(kReuseStep, kReuseGravity);
   ASSERT_GT(body->last_pcg_iterations(), 0);
   ASSERT_FALSE(body->system().factor_is_current());
   // A (A^-1 b) = b on the free DOFs to round-off: the solve factored this step's A.
@@ -78,18 +78,18 @@ TEST(FactorReuseTest, ConstraintSolvesAfterAReusedStepApplyThisStepsInverse) {
   body->ApplySystemMatrix(x, Ax);
   EXPECT_LT((Ax - b).norm(), 1e-10 * b.norm());
   // The next step, whose constraint solve is likely to need A^-1 again, factors directly.
-  body->EndStep(kStep);
-  body->BeginStep(kStep, kGravity);
+  body->EndStep(kReuseStep);
+  body->BeginStep(kReuseStep, kReuseGravity);
   EXPECT_EQ(body->last_pcg_iterations(), 0);
   EXPECT_TRUE(body->system().factor_is_current());
 }
 
 TEST(FactorReuseTest, RestoredStateContinuesBitIdenticallyOnTheKeptFactor) {
-  auto body = MakeCantilever(true);
+  auto body = MakeReuseCantilever(true);
   auto run = [&](int steps) {
     for (int step = 0; step < steps; ++step) {
-      body->BeginStep(kStep, kGravity);
-      body->EndStep(kStep);
+      body->BeginStep(kReuseStep, kReuseGravity);
+      body->EndStep(kReuseStep);
     }
   };
   run(5);
