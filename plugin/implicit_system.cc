@@ -72,7 +72,6 @@ void ImplicitSystem::Build(const ElementModel& model, const std::vector<NodeKind
   newton_analyzed_ = false;
   factor_current_ = false;
   exact_solves_ = false;
-  refactor_next_ = false;
 }
 
 void ImplicitSystem::Assemble(const ElementModel& model, const VecX& mass, double c_M, double c_K) {
@@ -123,10 +122,9 @@ void ImplicitSystem::Factor(const std::string& body) {
 int ImplicitSystem::SolveStep(Eigen::Ref<VecX> rhs, const std::string& body,
                               const FactorReuseSettings& reuse) {
   const double cost = CalcRefactorCost(ldlt_);
-  const bool try_kept = reuse.enabled && !use_cholmod_ && !exact_solves_ && !refactor_next_ &&
-                        ldlt_.factorized() && cost >= reuse.min_refactor_cost;
+  const bool try_kept = reuse.enabled && !use_cholmod_ && !exact_solves_ && ldlt_.factorized() &&
+                        cost >= reuse.min_refactor_cost;
   exact_solves_ = false;
-  refactor_next_ = false;
   if (try_kept) {
     const int n = num_free_dofs();
     for (int i = 0; i < n; ++i) cg_x_[i] = rhs[free_to_dof_[i]];
@@ -136,7 +134,7 @@ int ImplicitSystem::SolveStep(Eigen::Ref<VecX> rhs, const std::string& body,
       for (int i = 0; i < n; ++i) rhs[free_to_dof_[i]] = cg_x_[i];
       return iterations;
     }
-    // Out of budget: this step factors (below), and so does the next.
+    // Out of budget: this step factors (below); the next reuses that fresh factor.
   }
   Factor(body);
   Solve(rhs);
@@ -286,7 +284,6 @@ ImplicitSystem::NewtonState ImplicitSystem::SaveNewtonState() const {
   if (use_cholmod_) return state;
   state.system_factor = ldlt_;
   state.exact_solves = exact_solves_;
-  state.refactor_next = refactor_next_;
   if (!newton_analyzed_) return state;
   state.analyzed = true;
   state.H = H_;
@@ -313,7 +310,6 @@ void ImplicitSystem::RestoreNewtonState(const NewtonState& state) {
   if (factor_fits) ldlt_ = state.system_factor;
   factor_current_ = false;  // A is assembled again by the next step
   exact_solves_ = state.exact_solves;
-  refactor_next_ = state.refactor_next;
 }
 
 }  // namespace taut

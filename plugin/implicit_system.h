@@ -53,7 +53,7 @@ class ImplicitSystem {
   // "Factor reuse in the unconstrained step"): when `reuse` allows it and a factor of an earlier
   // step's A is held whose refactor costs at least reuse.min_refactor_cost PCG iterations, CG on
   // this A preconditioned by that factor runs to a relative residual of reuse.pcg_tolerance,
-  // within half that cost; else (also when the last step's constraint solve needed A^-1, see
+  // within that cost; else (also when the last step's constraint solve needed A^-1, see
   // EnsureCurrentFactor) A is factored and solved directly. Returns the PCG iterations, 0 for
   // the direct solve. Throws SimulationError naming `body` if A is not positive definite.
   int SolveStep(Eigen::Ref<VecX> rhs, const std::string& body, const FactorReuseSettings& reuse);
@@ -112,9 +112,8 @@ class ImplicitSystem {
     bool analyzed = false;  // H's pattern and symbolic analysis are set up
     Eigen::SparseMatrix<double> H;
     SparseLdlt factor;
-    SparseLdlt system_factor;    // A's factor of the last step that factored A
-    bool exact_solves = false;   // the last step's constraint solve needed this step's A^-1
-    bool refactor_next = false;  // the last PCG on a kept factor ran out of its budget
+    SparseLdlt system_factor;   // A's factor of the last step that factored A
+    bool exact_solves = false;  // the last step's constraint solve needed this step's A^-1
   };
   NewtonState SaveNewtonState() const;
   // Puts a saved state back (CHOLMOD: no-op). The system must be built with the node kinds of the
@@ -134,7 +133,6 @@ class ImplicitSystem {
   CholmodCholesky cholmod_;      // the factor when use_cholmod_
   bool factor_current_ = false;  // the factor is of A's values (not an earlier step's A)
   bool exact_solves_ = false;    // EnsureCurrentFactor was called since the last SolveStep
-  bool refactor_next_ = false;   // the last reuse PCG ran out of budget: factor at the next step
   // Cost of factoring A in PCG iterations with the held factor (4 nnz(L) + 2 nnz(A) flops each),
   // 0 without a SparseLdlt factor.
   double CalcRefactorCost(const SparseLdlt& factor) const;
