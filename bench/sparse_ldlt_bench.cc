@@ -70,11 +70,11 @@ const LdltCase& GetCase(const benchmark::State& state) {
 // What a benchmark times.
 enum class Op { kFactor, kSolve1, kSolve64Dense, kSolve64Sparse };
 
-// Times one operation with SparseLdlt.
-void RunTaut(benchmark::State& state, Op op) {
+// Times one operation with SparseLdlt and the given numeric kernel (kAuto: as a body gets it).
+void RunTaut(benchmark::State& state, Op op, SparseLdlt::Kernel kernel) {
   const LdltCase& c = GetCase(state);
   SparseLdlt ldlt;
-  ldlt.Analyze(c.A);
+  ldlt.Analyze(c.A, kernel);
   if (!ldlt.Factorize(c.A)) state.SkipWithError("factorization failed");
   VecX x = c.b;
   MatX X = c.B_dense;
@@ -100,6 +100,8 @@ void RunTaut(benchmark::State& state, Op op) {
   }
   state.counters["dofs"] = static_cast<double>(c.A.rows());
   state.counters["nnz_L"] = ldlt.nonzeros_in_L();
+  state.counters["work"] = ldlt.CalcFactorWork();
+  state.counters["supernodal"] = ldlt.supernodal() ? 1.0 : 0.0;
 }
 
 // Times one operation with Eigen::SimplicialLDLT (AMD ordering, lower triangle).
@@ -135,14 +137,35 @@ void RunEigen(benchmark::State& state, Op op) {
 // 6x6x8 cells: 441 nodes, 1,323 dofs. 14x14x14 cells: 3,375 nodes, 10,125 dofs.
 #define TAUT_LDLT_SIZES ->Args({6, 6, 8})->Args({14, 14, 14})->Unit(benchmark::kMicrosecond)
 
-BENCHMARK_CAPTURE(RunTaut, Factor, Op::kFactor) TAUT_LDLT_SIZES;
+using Kernel = SparseLdlt::Kernel;
+BENCHMARK_CAPTURE(RunTaut, Factor, Op::kFactor, Kernel::kAuto) TAUT_LDLT_SIZES;
 BENCHMARK_CAPTURE(RunEigen, Factor, Op::kFactor) TAUT_LDLT_SIZES;
-BENCHMARK_CAPTURE(RunTaut, Solve1, Op::kSolve1) TAUT_LDLT_SIZES;
+BENCHMARK_CAPTURE(RunTaut, Solve1, Op::kSolve1, Kernel::kAuto) TAUT_LDLT_SIZES;
 BENCHMARK_CAPTURE(RunEigen, Solve1, Op::kSolve1) TAUT_LDLT_SIZES;
-BENCHMARK_CAPTURE(RunTaut, Solve64Dense, Op::kSolve64Dense) TAUT_LDLT_SIZES;
+BENCHMARK_CAPTURE(RunTaut, Solve64Dense, Op::kSolve64Dense, Kernel::kAuto) TAUT_LDLT_SIZES;
 BENCHMARK_CAPTURE(RunEigen, Solve64Dense, Op::kSolve64Dense) TAUT_LDLT_SIZES;
-BENCHMARK_CAPTURE(RunTaut, Solve64Sparse, Op::kSolve64Sparse) TAUT_LDLT_SIZES;
+BENCHMARK_CAPTURE(RunTaut, Solve64Sparse, Op::kSolve64Sparse, Kernel::kAuto) TAUT_LDLT_SIZES;
 BENCHMARK_CAPTURE(RunEigen, Solve64Sparse, Op::kSolve64Sparse) TAUT_LDLT_SIZES;
+
+// Both kernels over a range of sizes, for SparseLdlt::kSupernodalMinWork (the work counter says
+// where each size falls): 3x3x3 cells (192 dofs) to 14x14x14.
+#define TAUT_KERNEL_SIZES  \
+  ->Args({3, 3, 3})        \
+      ->Args({4, 4, 4})    \
+      ->Args({5, 5, 6})    \
+      ->Args({6, 6, 8})    \
+      ->Args({8, 8, 8})    \
+      ->Args({10, 10, 10}) \
+      ->Args({14, 14, 14}) \
+      ->Unit(benchmark::kMicrosecond)
+BENCHMARK_CAPTURE(RunTaut, FactorUpLooking, Op::kFactor, Kernel::kUpLooking) TAUT_KERNEL_SIZES;
+BENCHMARK_CAPTURE(RunTaut, FactorSupernodal, Op::kFactor, Kernel::kSupernodal) TAUT_KERNEL_SIZES;
+BENCHMARK_CAPTURE(RunTaut, Solve64SparseUpLooking, Op::kSolve64Sparse, Kernel::kUpLooking)
+TAUT_KERNEL_SIZES;
+BENCHMARK_CAPTURE(RunTaut, Solve64SparseSupernodal, Op::kSolve64Sparse, Kernel::kSupernodal)
+TAUT_KERNEL_SIZES;
+BENCHMARK_CAPTURE(RunTaut, Solve1UpLooking, Op::kSolve1, Kernel::kUpLooking) TAUT_KERNEL_SIZES;
+BENCHMARK_CAPTURE(RunTaut, Solve1Supernodal, Op::kSolve1, Kernel::kSupernodal) TAUT_KERNEL_SIZES;
 
 }  // namespace
 }  // namespace taut

@@ -62,6 +62,8 @@ class ImplicitSystem {
   void EnsureCurrentFactor(const std::string& body);
   // True when the held factor is the one of this step's A (Solve and SolveColumns are exact).
   bool factor_is_current() const { return factor_current_; }
+  // True when A is factored by SparseLdlt's supernodal kernel (large bodies, default backend).
+  bool uses_supernodal_factor() const { return !use_cholmod_ && ldlt_.supernodal(); }
   // rhs (3N) <- A^-1 rhs on free DOFs; constrained DOFs set to 0. Requires factor_is_current().
   void Solve(Eigen::Ref<VecX> rhs) const;
   // Same for each column of rhs (3N x k).

@@ -9,7 +9,7 @@
 namespace taut {
 
 // Symbolic phase: validate, order (AMD), permute the pattern, etree and column counts, buffers.
-void SparseLdlt::Analyze(const SparseMatrix& pattern) {
+void SparseLdlt::Analyze(const SparseMatrix& pattern, Kernel kernel) {
   analyzed_ = false;
   factorized_ = false;
   failed_column_ = -1;
@@ -48,6 +48,10 @@ void SparseLdlt::Analyze(const SparseMatrix& pattern) {
   col_fill_.assign(n_, 0);
   work_.assign(static_cast<size_t>(n_) * kMaxBlockColumns, 0.0);
   analyzed_ = true;
+  supernodal_ = kernel == Kernel::kSupernodal ||
+                (kernel == Kernel::kAuto && CalcFactorWork() >= kSupernodalMinWork);
+  supernodal_factor_ = SupernodalCholesky();
+  if (supernodal_) supernodal_factor_.Analyze(n_, c_start_, c_row_, c_source_, parent_, col_start_);
 }
 
 // Counts, then fills, the entries of C per column, remembering where each value sits in A.
@@ -120,6 +124,17 @@ bool SparseLdlt::Factorize(const SparseMatrix& A) {
   failed_column_ = -1;
   num_negative_pivots_ = 0;
   const double* a_val = A.valuePtr();
+  if (supernodal_) {
+    if (!supernodal_factor_.Factorize(a_val)) {
+      failed_column_ = perm_[supernodal_factor_.failed_column()];
+      num_negative_pivots_ = supernodal_factor_.failed_pivot_negative() ? 1 : 0;
+      return false;
+    }
+    supernodal_factor_.CalcPivots(d_);
+    for (int k = 0; k < n_; ++k) d_inv_[k] = 1.0 / d_[k];
+    factorized_ = true;
+    return true;
+  }
   std::fill(flag_.begin(), flag_.end(), -1);
   std::fill(col_fill_.begin(), col_fill_.end(), 0);
 
@@ -175,6 +190,7 @@ void SparseLdlt::DemandReadyToSolve(Eigen::Index size) const {
 // One right-hand side through the width-1 kernel.
 void SparseLdlt::Solve(Eigen::Ref<VecX> b) const {
   DemandReadyToSolve(b.size());
+  if (supernodal_) return SolveSupernodal(b.data(), b.size(), 1);
   SolveBlock<1>(b.data(), b.size());
 }
 
@@ -184,6 +200,12 @@ void SparseLdlt::SolveColumns(Eigen::Ref<MatX> B) const {
   const Eigen::Index stride = B.outerStride();
   Eigen::Index c = 0;
   const Eigen::Index m = B.cols();
+  if (supernodal_) {
+    for (; c < m; c += kMaxBlockColumns)
+      SolveSupernodal(B.data() + c * stride, stride,
+                      static_cast<int>(std::min<Eigen::Index>(kMaxBlockColumns, m - c)));
+    return;
+  }
   for (; c + kMaxBlockColumns <= m; c += kMaxBlockColumns)
     SolveBlock<kMaxBlockColumns>(B.data() + c * stride, stride);
   if (c + 8 <= m) {
@@ -226,6 +248,17 @@ void SparseLdlt::SolveBlock(double* b, Eigen::Index outer_stride) const {
   // scatter: B = P^T W.
   for (int k = 0; k < n_; ++k)
     for (int c = 0; c < kWidth; ++c) b[perm_[k] + c * outer_stride] = w[k * kWidth + c];
+}
+
+// X = P B into the workspace (row-major, n x width), the supernodal solve, B = P^T X.
+void SparseLdlt::SolveSupernodal(double* b, Eigen::Index outer_stride, int width) const {
+  static_assert(kMaxBlockColumns <= SupernodalCholesky::kMaxSolveColumns, "solve block width");
+  double* w = work_.data();
+  for (int k = 0; k < n_; ++k)
+    for (int c = 0; c < width; ++c) w[k * width + c] = b[perm_[k] + c * outer_stride];
+  supernodal_factor_.Solve(w, width);
+  for (int k = 0; k < n_; ++k)
+    for (int c = 0; c < width; ++c) b[perm_[k] + c * outer_stride] = w[k * width + c];
 }
 
 double SparseLdlt::CalcFactorWork() const {

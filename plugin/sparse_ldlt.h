@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "plugin/common.h"
+#include "plugin/supernodal_cholesky.h"
 
 namespace taut {
 
@@ -27,10 +28,20 @@ namespace taut {
 // P A P^T are nonzero and reports the number of negative pivots, which equals the number of
 // negative eigenvalues of A (Sylvester's law of inertia), so callers can detect an indefinite A.
 //
+// Large matrices take the supernodal kernel instead (SupernodalCholesky: dense blocks, the same
+// ordering and elimination tree): from kSupernodalMinWork multiply-adds of factorization work,
+// where it is faster (measured in bench/sparse_ldlt_bench.cc). It factors SPD matrices only: an
+// indefinite A fails there at its first non-positive pivot instead of counting negative pivots.
+//
 // Not thread-safe: Solve and SolveColumns share a workspace inside the object.
 class SparseLdlt {
  public:
   using SparseMatrix = Eigen::SparseMatrix<double>;  // column-major, int indices
+
+  // Numeric kernel: chosen by size (kAuto), or forced.
+  enum class Kernel { kAuto, kUpLooking, kSupernodal };
+  // Factorization work (CalcFactorWork) from which kAuto picks the supernodal kernel.
+  static constexpr double kSupernodalMinWork = 2e6;
 
   // Largest number of right-hand sides SolveColumns carries through one pass over L.
   static constexpr int kMaxBlockColumns = 16;
@@ -38,7 +49,9 @@ class SparseLdlt {
   // Symbolic phase: AMD ordering of the symmetric pattern, elimination tree, column counts of L,
   // the map from A's values to the permuted upper triangle, and every workspace. Values are
   // ignored. Throws InputError for a non-square, empty or uncompressed matrix.
-  void Analyze(const SparseMatrix& pattern);
+  void Analyze(const SparseMatrix& pattern, Kernel kernel = Kernel::kAuto);
+  // True when Analyze chose (or was given) the supernodal kernel.
+  bool supernodal() const { return supernodal_; }
 
   // Numeric phase on a matrix with the analysed pattern (same outer index and nonzero count; the
   // row indices are compared in debug builds). No heap allocation. Returns false when a pivot is
@@ -82,6 +95,8 @@ class SparseLdlt {
   // Solves for kWidth columns stored at b + c * outer_stride, c = 0..kWidth-1.
   template <int kWidth>
   void SolveBlock(double* b, Eigen::Index outer_stride) const;
+  // Solves through the supernodal factor for `width` columns (gather P B, solve, scatter).
+  void SolveSupernodal(double* b, Eigen::Index outer_stride, int width) const;
   // Throws InputError unless a factorization is ready for right-hand sides with `size` rows.
   void DemandReadyToSolve(Eigen::Index size) const;
 
@@ -90,6 +105,8 @@ class SparseLdlt {
   bool factorized_ = false;
   int failed_column_ = -1;
   int num_negative_pivots_ = 0;
+  bool supernodal_ = false;
+  SupernodalCholesky supernodal_factor_;  // the factor when supernodal_
 
   // Ordering.
   std::vector<int> perm_;   // (n) new -> old

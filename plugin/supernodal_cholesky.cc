@@ -1,0 +1,259 @@
+#include "plugin/supernodal_cholesky.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+namespace taut {
+
+void SupernodalCholesky::Analyze(int n, const std::vector<int>& c_start,
+                                 const std::vector<int>& c_row, const std::vector<int>& c_source,
+                                 const std::vector<int>& parent,
+                                 const std::vector<int>& l_col_start) {
+  n_ = n;
+  FindSupernodes(n, parent, l_col_start);
+  BuildPanelRows(c_start, c_row, parent);
+  // Every panel's rows are its columns plus L's pattern below its first column.
+  for (int s = 0; s < num_supernodes(); ++s)
+    TAUT_ASSERT(rows_in(s) == l_col_start[sn_start_[s] + 1] - l_col_start[sn_start_[s]] + 1);
+  BuildScatterMap(c_start, c_row, c_source);
+}
+
+// Column j + 1 continues j's supernode when parent(j) = j + 1 and |L(:, j)| = |L(:, j + 1)| + 1:
+// then L(:, j) = {j + 1} + L(:, j + 1) (Liu, Ng and Peyton 1993, fundamental supernodes without
+// the single-child condition, which only matters for the tree shape, not for the pattern).
+void SupernodalCholesky::FindSupernodes(int n, const std::vector<int>& parent,
+                                        const std::vector<int>& l_col_start) {
+  sn_start_.clear();
+  sn_of_.assign(n, 0);
+  for (int j = 0; j < n; ++j) {
+    const bool continues =
+        j > 0 && parent[j - 1] == j &&
+        l_col_start[j] - l_col_start[j - 1] == l_col_start[j + 1] - l_col_start[j] + 1;
+    if (!continues) sn_start_.push_back(j);
+    sn_of_[j] = static_cast<int>(sn_start_.size()) - 1;
+  }
+  sn_start_.push_back(n);
+}
+
+void SupernodalCholesky::BuildPanelRows(const std::vector<int>& c_start,
+                                        const std::vector<int>& c_row,
+                                        const std::vector<int>& parent) {
+  const int num_sn = num_supernodes();
+  // C's strictly upper entries (r, c), r < c, are L's entries (c, r): rows of column r.
+  std::vector<int> lower_start(n_ + 1, 0);
+  for (int c = 0; c < n_; ++c)
+    for (int q = c_start[c]; q < c_start[c + 1]; ++q)
+      if (c_row[q] < c) lower_start[c_row[q] + 1]++;
+  for (int j = 0; j < n_; ++j) lower_start[j + 1] += lower_start[j];
+  std::vector<int> lower_row(lower_start[n_]);
+  std::vector<int> fill(lower_start.begin(), lower_start.end() - 1);
+  for (int c = 0; c < n_; ++c)
+    for (int q = c_start[c]; q < c_start[c + 1]; ++q)
+      if (c_row[q] < c) lower_row[fill[c_row[q]]++] = c;
+
+  // Children of each supernode in the supernodal etree.
+  std::vector<int> child_head(num_sn, -1), child_next(num_sn, -1);
+  for (int s = num_sn - 1; s >= 0; --s) {
+    const int p = parent[sn_start_[s + 1] - 1];
+    if (p < 0) continue;
+    child_next[s] = child_head[sn_of_[p]];
+    child_head[sn_of_[p]] = s;
+  }
+
+  row_start_.assign(num_sn + 1, 0);
+  rows_.clear();
+  std::vector<int> mark(n_, -1);
+  std::vector<int> below;
+  for (int s = 0; s < num_sn; ++s) {
+    const int first = sn_start_[s], end = sn_start_[s + 1];
+    below.clear();
+    auto add = [&](int r) {
+      if (r >= end && mark[r] != s) {
+        mark[r] = s;
+        below.push_back(r);
+      }
+    };
+    for (int j = first; j < end; ++j)
+      for (int q = lower_start[j]; q < lower_start[j + 1]; ++q) add(lower_row[q]);
+    for (int c = child_head[s]; c != -1; c = child_next[c])
+      for (int q = row_start_[c]; q < row_start_[c + 1]; ++q) add(rows_[q]);
+    std::sort(below.begin(), below.end());
+    for (int j = first; j < end; ++j) rows_.push_back(j);
+    rows_.insert(rows_.end(), below.begin(), below.end());
+    row_start_[s + 1] = static_cast<int>(rows_.size());
+  }
+}
+
+void SupernodalCholesky::BuildScatterMap(const std::vector<int>& c_start,
+                                         const std::vector<int>& c_row,
+                                         const std::vector<int>& c_source) {
+  const int num_sn = num_supernodes();
+  val_start_.assign(num_sn + 1, 0);
+  int64_t total = 0;
+  int max_rows = 0, max_width = 0;
+  for (int s = 0; s < num_sn; ++s) {
+    total += static_cast<int64_t>(rows_in(s)) * width(s);
+    TAUT_DEMAND(total <= std::numeric_limits<int>::max(),
+                "SupernodalCholesky::Analyze: the panels would hold more than 2^31 values");
+    val_start_[s + 1] = static_cast<int>(total);
+    max_rows = std::max(max_rows, rows_in(s));
+    max_width = std::max(max_width, width(s));
+  }
+  values_.assign(static_cast<size_t>(total), 0.0);
+
+  // Entry (r, c) of C, r <= c, is L's (c, r): column r's panel, at row c's position there.
+  std::vector<int> pos(n_, -1);
+  entry_dest_.assign(c_source.size(), 0);
+  entry_source_.assign(c_source.begin(), c_source.end());
+  std::vector<int> row_pos_of_entry(c_source.size());
+  // Positions are relative to the panel of the entry's column r; fill them panel by panel.
+  std::vector<int> entries_start(num_sn + 1, 0);
+  for (int c = 0; c < n_; ++c)
+    for (int q = c_start[c]; q < c_start[c + 1]; ++q) entries_start[sn_of_[c_row[q]] + 1]++;
+  for (int s = 0; s < num_sn; ++s) entries_start[s + 1] += entries_start[s];
+  std::vector<int> by_panel(c_source.size());
+  std::vector<int> next_slot(entries_start.begin(), entries_start.end() - 1);
+  for (int c = 0; c < n_; ++c)
+    for (int q = c_start[c]; q < c_start[c + 1]; ++q) by_panel[next_slot[sn_of_[c_row[q]]]++] = q;
+  std::vector<int> col_of(c_source.size());
+  for (int c = 0; c < n_; ++c)
+    for (int q = c_start[c]; q < c_start[c + 1]; ++q) col_of[q] = c;
+  for (int s = 0; s < num_sn; ++s) {
+    for (int k = 0; k < rows_in(s); ++k) pos[rows_[row_start_[s] + k]] = k;
+    for (int i = entries_start[s]; i < entries_start[s + 1]; ++i) {
+      const int q = by_panel[i];
+      const int r = c_row[q], c = col_of[q];
+      TAUT_ASSERT(pos[c] >= 0);
+      entry_dest_[q] = val_start_[s] + (r - sn_start_[s]) * rows_in(s) + pos[c];
+    }
+    for (int k = 0; k < rows_in(s); ++k) pos[rows_[row_start_[s] + k]] = -1;
+  }
+
+  map_.assign(n_, 0);
+  head_.assign(num_sn, -1);
+  next_.assign(num_sn, -1);
+  next_row_.assign(num_sn, 0);
+  update_.assign(static_cast<size_t>(max_rows) * max_width, 0.0);
+  solve_work_.assign(static_cast<size_t>(max_rows) * kMaxSolveColumns, 0.0);
+}
+
+bool SupernodalCholesky::Factorize(const double* a_val) {
+  failed_column_ = -1;
+  failed_pivot_negative_ = false;
+  std::fill(values_.begin(), values_.end(), 0.0);
+  for (size_t q = 0; q < entry_dest_.size(); ++q)
+    values_[entry_dest_[q]] += a_val[entry_source_[q]];
+  std::fill(head_.begin(), head_.end(), -1);
+  const int num_sn = num_supernodes();
+  for (int t = 0; t < num_sn; ++t) {
+    const int* rows_t = rows_.data() + row_start_[t];
+    for (int k = 0; k < rows_in(t); ++k) map_[rows_t[k]] = k;
+    // Step 2: every descendant whose next unconsumed row is one of t's columns.
+    for (int d = head_[t], after = 0; d != -1; d = after) {
+      after = next_[d];
+      const int* rows_d = rows_.data() + row_start_[d];
+      const int k1 = next_row_[d];
+      int k2 = k1;
+      while (k2 < rows_in(d) && rows_d[k2] < sn_start_[t + 1]) ++k2;
+      SubtractUpdate(d, k1, k2, t);
+      next_row_[d] = k2;
+      if (k2 < rows_in(d)) {
+        const int p = sn_of_[rows_d[k2]];
+        next_[d] = head_[p];
+        head_[p] = d;
+      }
+    }
+    if (!FactorPanel(t)) return false;
+    if (rows_in(t) > width(t)) {
+      next_row_[t] = width(t);
+      const int p = sn_of_[rows_t[width(t)]];
+      next_[t] = head_[p];
+      head_[p] = t;
+    }
+  }
+  return true;
+}
+
+// Panel_t(rows_d[i], rows_d[j]) -= sum_c L_d(i, c) L_d(j, c) for k1 <= j < k2, i >= j.
+void SupernodalCholesky::SubtractUpdate(int d, int k1, int k2, int t) {
+  const ConstPanel l_d = read_panel(d);
+  const int n1 = k2 - k1, n2 = rows_in(d) - k1;
+  Panel update(update_.data(), n2, n1);
+  update.noalias() = l_d.middleRows(k1, n2) * l_d.middleRows(k1, n1).transpose();
+  const int* rows_d = rows_.data() + row_start_[d];
+  Panel l_t = panel(t);
+  const int first_t = sn_start_[t];
+  for (int j = 0; j < n1; ++j) {
+    double* col = l_t.col(rows_d[k1 + j] - first_t).data();
+    for (int i = j; i < n2; ++i) col[map_[rows_d[k1 + i]]] -= update(i, j);
+  }
+}
+
+// L_tt L_tt^T = diagonal block (Eigen's blocked in-place Cholesky); L_below = below L_tt^-T.
+bool SupernodalCholesky::FactorPanel(int t) {
+  Panel l_t = panel(t);
+  const int w = width(t), m = rows_in(t);
+  Eigen::Ref<Eigen::MatrixXd> diagonal = l_t.topRows(w);
+  const Eigen::Index failed = Eigen::internal::llt_inplace<double, Eigen::Lower>::blocked(diagonal);
+  if (failed >= 0) {
+    failed_column_ = sn_start_[t] + static_cast<int>(failed);
+    failed_pivot_negative_ = true;
+    return false;
+  }
+  for (int k = 0; k < w; ++k)
+    if (!std::isfinite(diagonal(k, k))) {
+      failed_column_ = sn_start_[t] + k;
+      return false;
+    }
+  if (m > w)
+    diagonal.triangularView<Eigen::Lower>().transpose().solveInPlace<Eigen::OnTheRight>(
+        l_t.bottomRows(m - w));
+  return true;
+}
+
+// Forward L Z = Y then backward L^T X = Z, one supernode's dense blocks at a time.
+void SupernodalCholesky::Solve(double* y_data, int width_b) const {
+  TAUT_ASSERT(width_b <= kMaxSolveColumns);
+  using RowBlock =
+      Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>;
+  RowBlock y(y_data, n_, width_b);
+  const int num_sn = num_supernodes();
+  for (int s = 0; s < num_sn; ++s) {
+    const ConstPanel l_s = read_panel(s);
+    const int w = width(s), below = rows_in(s) - w;
+    auto y_s = y.middleRows(sn_start_[s], w);
+    // Zero rows stay zero (sparse right-hand sides such as columns of J^T).
+    if ((y_s.array() == 0.0).all()) continue;
+    l_s.topRows(w).triangularView<Eigen::Lower>().solveInPlace(y_s);
+    if (below == 0) continue;
+    RowBlock t(solve_work_.data(), below, width_b);
+    t.noalias() = l_s.bottomRows(below) * y_s;
+    const int* rows_below = rows_.data() + row_start_[s] + w;
+    for (int k = 0; k < below; ++k) y.row(rows_below[k]) -= t.row(k);
+  }
+  for (int s = num_sn - 1; s >= 0; --s) {
+    const ConstPanel l_s = read_panel(s);
+    const int w = width(s), below = rows_in(s) - w;
+    auto y_s = y.middleRows(sn_start_[s], w);
+    if (below > 0) {
+      RowBlock t(solve_work_.data(), below, width_b);
+      const int* rows_below = rows_.data() + row_start_[s] + w;
+      for (int k = 0; k < below; ++k) t.row(k) = y.row(rows_below[k]);
+      y_s.noalias() -= l_s.bottomRows(below).transpose() * t;
+    }
+    l_s.topRows(w).triangularView<Eigen::Lower>().transpose().solveInPlace(y_s);
+  }
+}
+
+void SupernodalCholesky::CalcPivots(std::vector<double>& d) const {
+  d.resize(n_);
+  for (int s = 0; s < num_supernodes(); ++s) {
+    const ConstPanel l_s = read_panel(s);
+    for (int k = 0; k < width(s); ++k) d[sn_start_[s] + k] = l_s(k, k) * l_s(k, k);
+  }
+}
+
+}  // namespace taut

@@ -1,0 +1,105 @@
+// Supernodal left-looking Cholesky kernel for SparseLdlt's large matrices.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "plugin/common.h"
+
+namespace taut {
+
+// C = L L^T of a symmetric positive definite matrix C given in SparseLdlt's permuted form (the
+// upper triangle of P A P^T by columns, its values read from A's value array), computed by
+// supernodes: runs of columns of L with one shared row pattern, each stored as a dense column-major
+// panel (its rows: the supernode's own columns, then the rows below them). Per supernode t
+// (left-looking, the scheme of CHOLMOD's supernodal factor; Ng and Peyton 1993):
+//   1. gather A's entries of t's columns into its panel,
+//   2. subtract L_d(rows of t's panel, :) L_d(t's columns, :)^T of every earlier supernode d whose
+//      rows reach t's columns (one dense product each),
+//   3. L_tt = chol(diagonal block), L_rest = panel_rest L_tt^-T (dense kernels).
+// The dense kernels run at BLAS-3 speed where the up-looking scalar algorithm touches one entry
+// at a time, so large 3D bodies (fronts of hundreds of columns) factor several times faster.
+//
+// Only SPD matrices: Factorize stops at the first pivot that is not positive and finite (an
+// indefinite or singular C), where the up-looking LDL^T would go on with negative pivots.
+// Factorize and the solves may allocate inside Eigen's dense products for large panels.
+class SupernodalCholesky {
+ public:
+  // Symbolic phase on C's pattern: supernodes from the elimination tree and the column counts
+  // of L, the row pattern of every panel, where each entry of A lands in the panels, workspaces.
+  // c_start/c_row: CSC of C's upper triangle; c_source: index into A's values of each entry;
+  // parent: etree of C (-1 at roots); l_col_start: column starts of L's strictly lower part.
+  void Analyze(int n, const std::vector<int>& c_start, const std::vector<int>& c_row,
+               const std::vector<int>& c_source, const std::vector<int>& parent,
+               const std::vector<int>& l_col_start);
+
+  // Numeric phase with A's values (the pattern Analyze saw). Returns false when a pivot is not
+  // positive and finite; failed_column() then names the permuted column (-1 otherwise) and
+  // failed_pivot_negative() whether that pivot was negative.
+  bool Factorize(const double* a_val);
+
+  // Solves C X = Y in place for a row-major (n x width) block Y (permuted order).
+  void Solve(double* y, int width) const;
+
+  // Pivots of the equivalent LDL^T: D_jj = L_jj^2 (valid after a successful Factorize).
+  void CalcPivots(std::vector<double>& d) const;
+
+  int num_supernodes() const { return static_cast<int>(sn_start_.size()) - 1; }
+  int failed_column() const { return failed_column_; }
+  bool failed_pivot_negative() const { return failed_pivot_negative_; }
+
+  // Widest right-hand-side block one pass of Solve carries.
+  static constexpr int kMaxSolveColumns = 16;
+
+ private:
+  using Panel = Eigen::Map<Eigen::MatrixXd>;
+  using ConstPanel = Eigen::Map<const Eigen::MatrixXd>;
+
+  // Partition of the columns into fundamental supernodes (column j + 1 joins j's supernode when
+  // it is j's etree parent and L(:, j) = {j + 1} + L(:, j + 1)).
+  void FindSupernodes(int n, const std::vector<int>& parent, const std::vector<int>& l_col_start);
+  // Row pattern of each panel: its columns, then the union of C's entries below them and the
+  // rows of its child supernodes (the etree's row-subtree property).
+  void BuildPanelRows(const std::vector<int>& c_start, const std::vector<int>& c_row,
+                      const std::vector<int>& parent);
+  // Where each entry of C lands in the panel storage, and the size of every workspace.
+  void BuildScatterMap(const std::vector<int>& c_start, const std::vector<int>& c_row,
+                       const std::vector<int>& c_source);
+  // Step 2 for one descendant d of t: rows [k1, m_d) of d's panel against rows [k1, k2).
+  void SubtractUpdate(int d, int k1, int k2, int t);
+  // Step 3: dense Cholesky of t's diagonal block and the triangular solve below it.
+  bool FactorPanel(int t);
+
+  Panel panel(int s) { return Panel(values_.data() + val_start_[s], rows_in(s), width(s)); }
+  ConstPanel read_panel(int s) const {
+    return ConstPanel(values_.data() + val_start_[s], rows_in(s), width(s));
+  }
+  int width(int s) const { return sn_start_[s + 1] - sn_start_[s]; }
+  int rows_in(int s) const { return row_start_[s + 1] - row_start_[s]; }
+
+  int n_ = 0;
+  std::vector<int> sn_start_;   // (S + 1) first column of each supernode
+  std::vector<int> sn_of_;      // (n) supernode of each column
+  std::vector<int> row_start_;  // (S + 1) start of each panel's rows in rows_
+  std::vector<int> rows_;       // row indices of all panels, ascending within one
+  std::vector<int> val_start_;  // (S + 1) start of each panel in values_
+  std::vector<double> values_;  // panels, column-major, leading dimension rows_in(s)
+
+  // A's entries: values_[entry_dest_[q]] += a_val[entry_source_[q]].
+  std::vector<int> entry_dest_;
+  std::vector<int> entry_source_;
+
+  // Factorize workspace: relative row positions in the current panel, the linked lists of
+  // descendants waiting for each supernode, each descendant's next row, the update product.
+  std::vector<int> map_;        // (n)
+  std::vector<int> head_;       // (S) first descendant waiting for supernode t, -1 if none
+  std::vector<int> next_;       // (S) next descendant in the same list
+  std::vector<int> next_row_;   // (S) index in d's rows of its first row not yet consumed
+  std::vector<double> update_;  // (max rows x max width)
+  mutable std::vector<double> solve_work_;  // (max rows x kMaxSolveColumns)
+
+  int failed_column_ = -1;
+  bool failed_pivot_negative_ = false;
+};
+
+}  // namespace taut

@@ -1,0 +1,129 @@
+// SparseLdlt's supernodal kernel (plugin/supernodal_cholesky.h) against its up-looking kernel on
+// the same ordering: the same solutions, pivots and fill, and failure on matrices that are not
+// SPD.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "plugin/box_tet_mesher.h"
+#include "plugin/sparse_ldlt.h"
+
+namespace taut {
+namespace {
+
+using SnSparse = SparseLdlt::SparseMatrix;
+
+// M + K with the 3x3-block pattern of an nx x ny x nz box tet mesh (K: random PSD 12x12 element
+// matrices B^T B; M: a positive diagonal in [0.1, 1.1]), full symmetric CSC.
+SnSparse MakeSnTetSystem(int nx, int ny, int nz, unsigned seed) {
+  const TetMesh mesh = MakeBoxTetMesh(Vec3(1, 0.5, 0.5), nx, ny, nz);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const int n = 3 * static_cast<int>(mesh.nodes.size());
+  std::vector<Eigen::Triplet<double>> t;
+  for (const auto& tet : mesh.tets) {
+    const Mat12 B = Mat12::NullaryExpr([&] { return u(rng); });
+    const Mat12 K_e = B.transpose() * B;
+    for (int a = 0; a < 4; ++a)
+      for (int b = 0; b < 4; ++b)
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c)
+            t.emplace_back(3 * tet[a] + r, 3 * tet[b] + c, K_e(3 * a + r, 3 * b + c));
+  }
+  for (int i = 0; i < n; ++i) t.emplace_back(i, i, 0.6 + 0.5 * u(rng));
+  SnSparse A(n, n);
+  A.setFromTriplets(t.begin(), t.end());
+  A.makeCompressed();
+  return A;
+}
+
+MatX MakeSnRhs(int n, int cols, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  return MatX::NullaryExpr(n, cols, [&] { return u(rng); });
+}
+
+// Factors A with both kernels and compares fill, pivots and a block of solves.
+void ExpectKernelsAgree(const SnSparse& A, int num_rhs) {
+  SparseLdlt up, sn;
+  up.Analyze(A, SparseLdlt::Kernel::kUpLooking);
+  sn.Analyze(A, SparseLdlt::Kernel::kSupernodal);
+  ASSERT_FALSE(up.supernodal());
+  ASSERT_TRUE(sn.supernodal());
+  EXPECT_EQ(up.nonzeros_in_L(), sn.nonzeros_in_L());
+  ASSERT_TRUE(up.Factorize(A));
+  ASSERT_TRUE(sn.Factorize(A));
+  EXPECT_EQ(sn.num_negative_pivots(), 0);
+  for (int k = 0; k < A.rows(); ++k)
+    EXPECT_NEAR(sn.pivots()[k], up.pivots()[k], 1e-10 * up.pivots()[k]) << "pivot " << k;
+  const MatX B = MakeSnRhs(static_cast<int>(A.rows()), num_rhs, 7);
+  MatX X_up = B, X_sn = B;
+  up.SolveColumns(X_up);
+  sn.SolveColumns(X_sn);
+  EXPECT_LT((X_sn - X_up).norm(), 1e-10 * X_up.norm()) << "n = " << A.rows();
+  EXPECT_LT((A * X_sn - B).norm(), 1e-12 * A.norm() * X_sn.norm());
+  VecX x = B.col(0);
+  sn.Solve(x);
+  EXPECT_LT((x - X_sn.col(0)).norm(), 1e-14 * x.norm());
+}
+
+TEST(SupernodalCholeskyTest, SolvesLikeTheUpLookingKernel) {
+  ExpectKernelsAgree(MakeSnTetSystem(2, 1, 1, 1), 1);    // a few supernodes
+  ExpectKernelsAgree(MakeSnTetSystem(8, 3, 3, 2), 5);    // 432 unknowns
+  ExpectKernelsAgree(MakeSnTetSystem(14, 4, 4, 3), 37);  // 16 + 16 + 5 columns per pass
+}
+
+TEST(SupernodalCholeskyTest, AutoKernelFollowsTheFactorWork) {
+  const SnSparse small = MakeSnTetSystem(3, 2, 2, 4);
+  const SnSparse large = MakeSnTetSystem(20, 5, 5, 5);
+  SparseLdlt a, b;
+  a.Analyze(small);
+  b.Analyze(large);
+  EXPECT_LT(a.CalcFactorWork(), SparseLdlt::kSupernodalMinWork);
+  EXPECT_FALSE(a.supernodal());
+  EXPECT_GE(b.CalcFactorWork(), SparseLdlt::kSupernodalMinWork);
+  EXPECT_TRUE(b.supernodal());
+}
+
+TEST(SupernodalCholeskyTest, RefactorsNewValuesOnTheSamePattern) {
+  SnSparse A = MakeSnTetSystem(6, 3, 2, 6);
+  SparseLdlt sn;
+  sn.Analyze(A, SparseLdlt::Kernel::kSupernodal);
+  ASSERT_TRUE(sn.Factorize(A));
+  for (int k = 0; k < A.outerSize(); ++k)
+    for (SnSparse::InnerIterator it(A, k); it; ++it)
+      if (it.row() == it.col()) it.valueRef() *= 3.0;  // still SPD, a different factor
+  ASSERT_TRUE(sn.Factorize(A));
+  const VecX b = MakeSnRhs(static_cast<int>(A.rows()), 1, 8);
+  VecX x = b;
+  sn.Solve(x);
+  EXPECT_LT((A * x - b).norm(), 1e-12 * b.norm());
+}
+
+TEST(SupernodalCholeskyTest, FailsOnAMatrixThatIsNotPositiveDefinite) {
+  SnSparse A = MakeSnTetSystem(6, 3, 2, 9);
+  const SnSparse A_spd = A;
+  // Shifting by -1.0 I takes the diagonal mass below zero on some DOFs: A is indefinite.
+  for (int k = 0; k < A.outerSize(); ++k)
+    for (SnSparse::InnerIterator it(A, k); it; ++it)
+      if (it.row() == it.col()) it.valueRef() -= 1.0e3;
+  SparseLdlt sn;
+  sn.Analyze(A, SparseLdlt::Kernel::kSupernodal);
+  EXPECT_FALSE(sn.Factorize(A));
+  EXPECT_FALSE(sn.factorized());
+  EXPECT_GE(sn.failed_column(), 0);
+  EXPECT_LT(sn.failed_column(), A.rows());
+  EXPECT_EQ(sn.num_negative_pivots(), 1);
+  // A non-finite entry fails too; the object then factors an SPD matrix again.
+  SnSparse A_nan = A_spd;
+  A_nan.valuePtr()[0] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(sn.Factorize(A_nan));
+  EXPECT_TRUE(sn.Factorize(A_spd));
+  EXPECT_TRUE(sn.factorized());
+}
+
+}  // namespace
+}  // namespace taut
