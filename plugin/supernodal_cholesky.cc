@@ -14,10 +14,12 @@ void SupernodalCholesky::Analyze(int n, const std::vector<int>& c_start,
                                  const std::vector<int>& l_col_start) {
   n_ = n;
   FindSupernodes(n, parent, l_col_start);
+  AmalgamateSupernodes(parent, l_col_start);
   BuildPanelRows(c_start, c_row, parent);
-  // Every panel's rows are its columns plus L's pattern below its first column.
+  // Every panel's rows are its columns plus L's pattern below its first column (and the rows a
+  // merged child brought).
   for (int s = 0; s < num_supernodes(); ++s)
-    TAUT_ASSERT(rows_in(s) == l_col_start[sn_start_[s] + 1] - l_col_start[sn_start_[s]] + 1);
+    TAUT_ASSERT(rows_in(s) >= l_col_start[sn_start_[s] + 1] - l_col_start[sn_start_[s]] + 1);
   BuildScatterMap(c_start, c_row, c_source);
 }
 
@@ -36,6 +38,45 @@ void SupernodalCholesky::FindSupernodes(int n, const std::vector<int>& parent,
     sn_of_[j] = static_cast<int>(sn_start_.size()) - 1;
   }
   sn_start_.push_back(n);
+}
+
+// Relaxed amalgamation (Ashcraft and Grimes 1989; CHOLMOD's default thresholds): a supernode
+// merges into the next one, its etree parent, when the merged panel stays small or its stored
+// zeros stay a small share: up to 4 columns always, 16 with < 80 %, 48 with < 10 %, any with
+// < 5 % zeros. Fewer, wider panels: fewer dense calls and scatters for the same work.
+void SupernodalCholesky::AmalgamateSupernodes(const std::vector<int>& parent,
+                                              const std::vector<int>& l_col_start) {
+  // Stored entries of a w-column panel with m rows (its lower trapezoid).
+  auto stored = [](double w, double m) { return w * m - 0.5 * w * (w - 1.0); };
+  std::vector<int> merged{0};
+  double group_zeros = 0.0;
+  int group_rows = 0;  // rows of the current group's panel
+  for (int s = 0; s < num_supernodes(); ++s) {
+    const int first = sn_start_[s], w = width(s);
+    const int m = l_col_start[first + 1] - l_col_start[first] + 1;
+    const int group_first = merged.back(), group_width = first - group_first;
+    bool merge = false;
+    double zeros = 0.0;
+    if (group_width > 0 && parent[first - 1] == first) {
+      const double cols = group_width + w, rows = group_width + m;
+      zeros = stored(cols, rows) - (stored(group_width, group_rows) - group_zeros) - stored(w, m);
+      const double share = zeros / stored(cols, rows);
+      merge =
+          cols <= 4 || (cols <= 16 && share < 0.8) || (cols <= 48 && share < 0.1) || share < 0.05;
+    }
+    if (merge) {
+      group_zeros = zeros;
+      group_rows = group_width + m;
+    } else {
+      if (s > 0) merged.push_back(first);
+      group_zeros = 0.0;
+      group_rows = m;
+    }
+  }
+  merged.push_back(n_);
+  sn_start_ = merged;
+  for (int s = 0; s < num_supernodes(); ++s)
+    for (int j = sn_start_[s]; j < sn_start_[s + 1]; ++j) sn_of_[j] = s;
 }
 
 void SupernodalCholesky::BuildPanelRows(const std::vector<int>& c_start,

@@ -58,6 +58,8 @@ class SupernodalCholesky {
   // Partition of the columns into fundamental supernodes (column j + 1 joins j's supernode when
   // it is j's etree parent and L(:, j) = {j + 1} + L(:, j + 1)).
   void FindSupernodes(int n, const std::vector<int>& parent, const std::vector<int>& l_col_start);
+  // Merges small supernodes into their parents where few stored zeros result.
+  void AmalgamateSupernodes(const std::vector<int>& parent, const std::vector<int>& l_col_start);
   // Row pattern of each panel: its columns, then the union of C's entries below them and the
   // rows of its child supernodes (the etree's row-subtree property).
   void BuildPanelRows(const std::vector<int>& c_start, const std::vector<int>& c_row,
