@@ -156,6 +156,7 @@ BENCHMARK_CAPTURE(RunEigen, Solve64Sparse, Op::kSolve64Sparse) TAUT_LDLT_SIZES;
       ->Args({6, 6, 8})    \
       ->Args({8, 8, 8})    \
       ->Args({10, 10, 10}) \
+      ->Args({20, 4, 4})   \
       ->Args({14, 14, 14}) \
       ->Unit(benchmark::kMicrosecond)
 BENCHMARK_CAPTURE(RunTaut, FactorUpLooking, Op::kFactor, Kernel::kUpLooking) TAUT_KERNEL_SIZES;
