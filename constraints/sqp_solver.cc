@@ -37,21 +37,13 @@ void SqpSolver::CalcPositions(double h, const std::vector<IslandBody*>& bodies,
 void SqpSolver::BuildDelassus(const std::vector<IslandBody*>& bodies) {
   const int m = rows_.size();
   W_.setZero(m, m);
-  Y_.resize(bodies.size());
+  // Y_b = A_b^-1 J_b^T, kept across this step's SQP iterations where a row's J is unchanged.
+  columns_.Build(bodies, rows_);
   for (size_t b = 0; b < bodies.size(); ++b) {
     const std::vector<int>& rows = rows_.body_rows(static_cast<int>(b));
     if (rows.empty()) continue;
     const int body = static_cast<int>(b);
-    // Y_b = A_b^-1 J_b^T: scatter the row's entries on body b into columns, one multi-column
-    // solve.
-    MatX& Y = Y_[b];
-    Y.setZero(3 * bodies[b]->num_blocks(), static_cast<int>(rows.size()));
-    for (size_t k = 0; k < rows.size(); ++k) {
-      rows_[rows[k]].ForEachEntry([&](int on, int block, const Vec3& J) {
-        if (on == body) Y.col(k).segment<3>(3 * block) += J;
-      });
-    }
-    bodies[b]->SolveSystemColumns(Y);
+    const MatX& Y = columns_.Y(body);
     // W_c. += J_cb Y_b (J sparse over a row's blocks): a 1x3 times 3xm product per block.
     for (size_t i = 0; i < rows.size(); ++i) {
       w_row_.setZero(static_cast<int>(rows.size()));
@@ -148,6 +140,7 @@ void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
   v_trial_.resize(nb);
   dv_.resize(nb);
   for (size_t b = 0; b < nb; ++b) v_k_[b] = bodies[b]->v();
+  columns_.Clear();  // this step's A
   if (settings.warm_start) {
     iterate_ = previous_;
   } else {
@@ -233,7 +226,8 @@ void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     for (size_t b = 0; b < nb; ++b) {
       v_qp_[b] = restoring ? v_k_[b] : bodies[b]->v_star();
       const std::vector<int>& rows = rows_.body_rows(static_cast<int>(b));
-      for (size_t i = 0; i < rows.size(); ++i) v_qp_[b] += Y_[b].col(i) * lambda_qp_[rows[i]];
+      const MatX& Y = columns_.Y(static_cast<int>(b));
+      for (size_t i = 0; i < rows.size(); ++i) v_qp_[b] += Y.col(i) * lambda_qp_[rows[i]];
     }
     if (restoring) {
       // Accept the push only as far as it lowers the total violation (halving, as the merit).

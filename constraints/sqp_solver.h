@@ -6,6 +6,7 @@
 
 #include "constraints/active_set_polish.h"
 #include "constraints/constraint_row.h"
+#include "constraints/delassus_columns.h"
 #include "constraints/island_body.h"
 #include "constraints/island_rows.h"
 #include "constraints/kkt_certificate.h"
@@ -69,8 +70,8 @@ class SqpSolver {
 
   IslandRows rows_;
   std::vector<PgsRow> pgs_rows_;
-  std::vector<MatX> Y_;  // (num_bodies) 3N x rows of the body
-  std::vector<VecX> x_;  // (num_bodies) positions at a trial velocity
+  DelassusColumns columns_;  // Y_b = A_b^-1 J_b^T per body
+  std::vector<VecX> x_;      // (num_bodies) positions at a trial velocity
   MatX W_;
   VecX q_, lambda_, lambda_qp_, w_;
   IslandRows full_rows_;           // rows at the full QP step

@@ -1,0 +1,114 @@
+// DelassusColumns (constraints/delassus_columns.h): every column is A^-1 J^T of its own row, a
+// row that comes back with the same key and J keeps its column, and a row whose J moved is
+// solved again.
+#include "constraints/delassus_columns.h"
+
+#include <gtest/gtest.h>
+
+#include <memory>
+
+#include "constraints/deformable_island_body.h"
+#include "plugin/box_tet_mesher.h"
+#include "plugin/tet_element_model.h"
+
+namespace taut {
+namespace {
+
+constexpr double kDelassusH = 0.01;
+
+// Emits one row per (key, node, J) entry given, on body 0.
+class ListedRows final : public ConstraintSource {
+ public:
+  struct Entry {
+    std::uint64_t key;
+    int node;
+    Vec3 J;
+  };
+  std::vector<Entry> entries;
+  int AppendIslandRows(const IslandIterate& /*iterate*/,
+                       std::vector<ConstraintRow>& rows) override {
+    for (const Entry& e : entries) {
+      ConstraintRow& row = rows.emplace_back();
+      row.key = e.key;
+      row.C = 0.5;
+      row.body = 0;
+      row.type = RowType::kContact;
+      row.num_nodes = 1;
+      row.nodes[0] = e.node;
+      row.J[0] = e.J;
+    }
+    return static_cast<int>(entries.size());
+  }
+  double CalcIslandViolationSum(const IslandIterate& /*iterate*/) const override { return 0.0; }
+};
+
+class DelassusColumnsTest : public ::testing::Test {
+ protected:
+  DelassusColumnsTest()
+      : body_(std::make_unique<TetElementModel>(
+                  std::make_shared<const TetMesh>(MakeBoxTetMesh(Vec3(0.6, 0.2, 0.2), 3, 1, 1)),
+                  Material{}),
+              DeformableBodySettings{}),
+        island_body_(body_) {
+    body_.BeginStep(kDelassusH, Vec3(0, 0, -9.81));
+  }
+  // Rows of `source` collected at v = 0, then the columns built.
+  void Build(ListedRows& source) {
+    std::vector<IslandBody*> bodies{&island_body_};
+    rows_.Collect(kDelassusH, bodies, {&source}, {VecX::Zero(3 * island_body_.num_blocks())}, 1.0);
+    columns_.Build(bodies, rows_);
+  }
+  // A^-1 e_node J, solved on its own.
+  VecX SolveOne(int node, const Vec3& J) {
+    VecX rhs = VecX::Zero(3 * island_body_.num_blocks());
+    rhs.segment<3>(3 * node) = J;
+    MatX column = rhs;
+    island_body_.SolveSystemColumns(column);
+    return column.col(0);
+  }
+
+  DeformableBody body_;
+  DeformableIslandBody island_body_;
+  IslandRows rows_;
+  DelassusColumns columns_;
+};
+
+TEST_F(DelassusColumnsTest, KeepsColumnsOfUnchangedRowsAndSolvesTheOthers) {
+  ListedRows source;
+  source.entries = {{11, 5, Vec3::UnitZ()}, {12, 6, Vec3::UnitX()}, {13, 7, Vec3(0, 0.6, 0.8)}};
+  Build(source);
+  EXPECT_EQ(columns_.columns_solved(), 3);
+  EXPECT_EQ(columns_.columns_kept(), 0);
+  // Next iteration: row 12's J moved, row 14 is new, 13 and 11 come back in another order.
+  source.entries = {{13, 7, Vec3(0, 0.6, 0.8)},
+                    {12, 6, Vec3(0.8, 0.6, 0)},
+                    {14, 2, Vec3::UnitY()},
+                    {11, 5, Vec3::UnitZ()}};
+  Build(source);
+  EXPECT_EQ(columns_.columns_solved(), 5);
+  EXPECT_EQ(columns_.columns_kept(), 2);
+  const MatX& Y = columns_.Y(0);
+  ASSERT_EQ(Y.cols(), 4);
+  for (int k = 0; k < 4; ++k) {
+    const ListedRows::Entry& e = source.entries[rows_.body_rows(0)[k]];
+    const VecX expected = SolveOne(e.node, e.J);
+    EXPECT_LT((Y.col(k) - expected).norm(), 1e-14 * expected.norm()) << "row key " << e.key;
+  }
+}
+
+TEST_F(DelassusColumnsTest, ClearForgetsTheKeptColumns) {
+  ListedRows source;
+  source.entries = {{21, 3, Vec3::UnitZ()}};
+  Build(source);
+  columns_.Clear();
+  // A new step: A changed, so the same row is solved again.
+  body_.BeginStep(kDelassusH, Vec3(0, 0, -9.81));
+  Build(source);
+  EXPECT_EQ(columns_.columns_solved(), 1);
+  EXPECT_EQ(columns_.columns_kept(), 0);
+  const VecX expected = SolveOne(3, Vec3::UnitZ());
+  EXPECT_LT((columns_.Y(0).col(0) - expected).norm(), 1e-14 * expected.norm());
+}
+
+}  // namespace
+}  // namespace taut
