@@ -12,14 +12,15 @@
 
 #include "plugin/box_tet_mesher.h"
 #include "plugin/sparse_ldlt.h"
+#include "tests/tet_block_spd.h"
 
 namespace taut {
 namespace {
 
 using SparseMatrix = SparseLdlt::SparseMatrix;
 
-// One benchmark case: A = M + K with random SPD tet blocks on an n x n x n-cell box (full
-// symmetric CSC) and right-hand sides.
+// One benchmark case: A = M + K with random SPD tet blocks on an nx x ny x nz-cell box
+// (tests/tet_block_spd.h) and right-hand sides.
 struct LdltCase {
   SparseMatrix A;
   VecX b;
@@ -33,23 +34,11 @@ const LdltCase& GetCase(int nx, int ny, int nz) {
   auto found = cases.find({nx, ny, nz});
   if (found != cases.end()) return found->second;
   const TetMesh mesh = MakeBoxTetMesh(Vec3(1, 1, 1), nx, ny, nz);
-  std::mt19937 rng(1);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  const int n = 3 * static_cast<int>(mesh.nodes.size());
-  std::vector<Eigen::Triplet<double>> t;
-  for (const auto& tet : mesh.tets) {
-    const Mat12 B = Mat12::NullaryExpr([&] { return u(rng); });
-    const Mat12 K_e = B.transpose() * B;
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
-        for (int r = 0; r < 3; ++r)
-          for (int c = 0; c < 3; ++c)
-            t.emplace_back(3 * tet[a] + r, 3 * tet[b] + c, K_e(3 * a + r, 3 * b + c));
-  }
-  for (int i = 0; i < n; ++i) t.emplace_back(i, i, 1.0);
   LdltCase& out = cases[{nx, ny, nz}];
-  out.A.resize(n, n);
-  out.A.setFromTriplets(t.begin(), t.end());
+  out.A = testing::MakeRandomTetBlockSpd(nx, ny, nz, 1);
+  const int n = static_cast<int>(out.A.rows());
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
   out.b = VecX::NullaryExpr(n, [&] { return u(rng); });
   out.B_dense = MatX::NullaryExpr(n, 64, [&] { return u(rng); });
   out.B_sparse = MatX::Zero(n, 64);

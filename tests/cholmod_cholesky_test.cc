@@ -17,35 +17,13 @@
 #include "plugin/implicit_system.h"
 #include "plugin/tet_element_model.h"
 #include "tests/allocation_counter.h"
+#include "tests/tet_block_spd.h"
 
 namespace taut {
 namespace {
 
 using SparseMatrix = CholmodCholesky::SparseMatrix;
 using Triplet = Eigen::Triplet<double>;
-
-// M + K with the 3x3-block pattern of a box tet mesh: K sums random PSD 12x12 element matrices
-// B^T B, M is a random positive diagonal. Full symmetric CSC, SPD.
-SparseMatrix MakeTetBlockSpd(int nx, int ny, int nz, unsigned seed) {
-  const TetMesh mesh = MakeBoxTetMesh(Vec3(1, 1, 1), nx, ny, nz);
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  const int n = 3 * static_cast<int>(mesh.nodes.size());
-  std::vector<Triplet> t;
-  for (const auto& tet : mesh.tets) {
-    const Mat12 B = Mat12::NullaryExpr([&] { return u(rng); });
-    const Mat12 K_e = B.transpose() * B;
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
-        for (int r = 0; r < 3; ++r)
-          for (int c = 0; c < 3; ++c)
-            t.emplace_back(3 * tet[a] + r, 3 * tet[b] + c, K_e(3 * a + r, 3 * b + c));
-  }
-  for (int i = 0; i < n; ++i) t.emplace_back(i, i, 0.1 + 0.5 * (1.0 + u(rng)));
-  SparseMatrix A(n, n);
-  A.setFromTriplets(t.begin(), t.end());
-  return A;
-}
 
 // Random vector with entries in [-1, 1].
 VecX MakeRandomVec(int n, unsigned seed) {
@@ -66,7 +44,7 @@ void AnalyzeAndFactor(CholmodCholesky& chol, const SparseMatrix& A) {
 TEST(CholmodCholeskyTest, SolvesRandomSpdSystemsLikeEigenSimplicialLdlt) {
   // 24, 375 and 3000 unknowns: one supernode up to many.
   for (const auto& [cells, seed] : {std::pair{1, 3u}, std::pair{4, 5u}, std::pair{9, 7u}}) {
-    const SparseMatrix A = MakeTetBlockSpd(cells, cells, cells, seed);
+    const SparseMatrix A = testing::MakeRandomTetBlockSpd(cells, cells, cells, seed);
     CholmodCholesky chol;
     AnalyzeAndFactor(chol, A);
     EXPECT_TRUE(chol.factorized());
@@ -81,7 +59,7 @@ TEST(CholmodCholeskyTest, SolvesRandomSpdSystemsLikeEigenSimplicialLdlt) {
 }
 
 TEST(CholmodCholeskyTest, ReadsOnlyTheUpperTriangleAndPermutesAllColumns) {
-  const SparseMatrix A = MakeTetBlockSpd(3, 2, 2, 10);
+  const SparseMatrix A = testing::MakeRandomTetBlockSpd(3, 2, 2, 10);
   SparseMatrix U = A.triangularView<Eigen::Upper>();
   CholmodCholesky full, upper;
   AnalyzeAndFactor(full, A);
@@ -96,7 +74,7 @@ TEST(CholmodCholeskyTest, ReadsOnlyTheUpperTriangleAndPermutesAllColumns) {
 }
 
 TEST(CholmodCholeskyTest, SolveColumnsEqualsColumnByColumnSolve) {
-  const SparseMatrix A = MakeTetBlockSpd(3, 3, 3, 16);
+  const SparseMatrix A = testing::MakeRandomTetBlockSpd(3, 3, 3, 16);
   const int n = static_cast<int>(A.rows());
   CholmodCholesky chol;
   AnalyzeAndFactor(chol, A);
@@ -120,13 +98,13 @@ TEST(CholmodCholeskyTest, SolveColumnsEqualsColumnByColumnSolve) {
 }
 
 TEST(CholmodCholeskyTest, RefactorsNewValuesAndSurvivesAMove) {
-  SparseMatrix A = MakeTetBlockSpd(3, 3, 2, 13);
+  SparseMatrix A = testing::MakeRandomTetBlockSpd(3, 3, 2, 13);
   CholmodCholesky chol;
   AnalyzeAndFactor(chol, A);
   const VecX b = MakeRandomVec(static_cast<int>(A.rows()), 14);
   VecX x_old = b;
   chol.Solve(x_old);
-  const SparseMatrix A_new = MakeTetBlockSpd(3, 3, 2, 15);
+  const SparseMatrix A_new = testing::MakeRandomTetBlockSpd(3, 3, 2, 15);
   std::copy(A_new.valuePtr(), A_new.valuePtr() + A_new.nonZeros(), A.valuePtr());
   CholmodCholesky moved = std::move(chol);
   ASSERT_TRUE(moved.Factorize(A));
@@ -138,7 +116,7 @@ TEST(CholmodCholeskyTest, RefactorsNewValuesAndSurvivesAMove) {
 }
 
 TEST(CholmodCholeskyTest, ReportsIndefiniteAndNonFiniteMatricesAndRecovers) {
-  SparseMatrix A = MakeTetBlockSpd(2, 2, 2, 20);
+  SparseMatrix A = testing::MakeRandomTetBlockSpd(2, 2, 2, 20);
   const SparseMatrix A_good = A;
   const int dead = 17;
   A.coeffRef(dead, dead) = -50.0;  // a negative eigenvalue
@@ -169,7 +147,7 @@ TEST(CholmodCholeskyTest, ReportsIndefiniteAndNonFiniteMatricesAndRecovers) {
 
 TEST(CholmodCholeskyTest, RejectsBadInput) {
   CholmodCholesky chol;
-  const SparseMatrix A = MakeTetBlockSpd(2, 1, 1, 1);
+  const SparseMatrix A = testing::MakeRandomTetBlockSpd(2, 1, 1, 1);
   EXPECT_THROW(chol.Factorize(A), InputError);  // before Analyze
   EXPECT_THROW(chol.Analyze(SparseMatrix(3, 4)), InputError);
   EXPECT_THROW(chol.Analyze(SparseMatrix(0, 0)), InputError);
@@ -177,7 +155,8 @@ TEST(CholmodCholeskyTest, RejectsBadInput) {
   uncompressed.uncompress();
   EXPECT_THROW(chol.Analyze(uncompressed), InputError);
   chol.Analyze(A);
-  EXPECT_THROW(chol.Factorize(MakeTetBlockSpd(2, 2, 1, 1)), InputError);  // other size
+  EXPECT_THROW(chol.Factorize(testing::MakeRandomTetBlockSpd(2, 2, 1, 1)),
+               InputError);  // other size
   SparseMatrix other_pattern = A;
   other_pattern.coeffRef(0, A.cols() - 1) = 1.0;
   other_pattern.makeCompressed();
@@ -192,7 +171,7 @@ TEST(CholmodCholeskyTest, RejectsBadInput) {
 }
 
 TEST(CholmodCholeskyTest, SolvesDoNotAllocateButFactorizeDoes) {
-  SparseMatrix A = MakeTetBlockSpd(4, 4, 3, 30);
+  SparseMatrix A = testing::MakeRandomTetBlockSpd(4, 4, 3, 30);
   const int n = static_cast<int>(A.rows());
   CholmodCholesky chol;
   AnalyzeAndFactor(chol, A);

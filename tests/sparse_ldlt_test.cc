@@ -9,6 +9,7 @@
 
 #include "plugin/box_tet_mesher.h"
 #include "tests/allocation_counter.h"
+#include "tests/tet_block_spd.h"
 
 namespace taut {
 namespace {
@@ -33,29 +34,6 @@ SparseMatrix MakeGridLaplacian(int nx, int ny, int nz, double shift) {
         if (k + 1 < nz)
           t.emplace_back(a, id(i, j, k + 1), -1.0), t.emplace_back(id(i, j, k + 1), a, -1.0);
       }
-  SparseMatrix A(n, n);
-  A.setFromTriplets(t.begin(), t.end());
-  return A;
-}
-
-// M + K with the 3x3-block pattern of a box tet mesh: K sums random PSD 12x12 element matrices
-// B^T B, M is a random positive diagonal. Full symmetric CSC, SPD.
-SparseMatrix MakeTetBlockSpd(int nx, int ny, int nz, unsigned seed) {
-  const TetMesh mesh = MakeBoxTetMesh(Vec3(1, 1, 1), nx, ny, nz);
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  const int n = 3 * static_cast<int>(mesh.nodes.size());
-  std::vector<Triplet> t;
-  for (const auto& tet : mesh.tets) {
-    Mat12 B = Mat12::NullaryExpr([&] { return u(rng); });
-    const Mat12 K_e = B.transpose() * B;
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
-        for (int r = 0; r < 3; ++r)
-          for (int c = 0; c < 3; ++c)
-            t.emplace_back(3 * tet[a] + r, 3 * tet[b] + c, K_e(3 * a + r, 3 * b + c));
-  }
-  for (int i = 0; i < n; ++i) t.emplace_back(i, i, 0.1 + 0.5 * (1.0 + u(rng)));
   SparseMatrix A(n, n);
   A.setFromTriplets(t.begin(), t.end());
   return A;
@@ -99,10 +77,10 @@ TEST(SparseLdltTest, SolvesGridLaplacianLikeReference) {
 }
 
 TEST(SparseLdltTest, SolvesTetBlockPatternLikeReference) {
-  ExpectSolveMatchesReference(MakeTetBlockSpd(1, 1, 1, 3), 4);  // 24 unknowns
-  ExpectSolveMatchesReference(MakeTetBlockSpd(3, 2, 2, 5), 6);  // 108 unknowns
-  ExpectSolveMatchesReference(MakeTetBlockSpd(4, 4, 4, 5), 6);  // 375 unknowns
-  ExpectSolveMatchesReference(MakeTetBlockSpd(9, 9, 9, 7), 8);  // 3000 unknowns
+  ExpectSolveMatchesReference(testing::MakeRandomTetBlockSpd(1, 1, 1, 3), 4);  // 24 unknowns
+  ExpectSolveMatchesReference(testing::MakeRandomTetBlockSpd(3, 2, 2, 5), 6);  // 108 unknowns
+  ExpectSolveMatchesReference(testing::MakeRandomTetBlockSpd(4, 4, 4, 5), 6);  // 375 unknowns
+  ExpectSolveMatchesReference(testing::MakeRandomTetBlockSpd(9, 9, 9, 7), 8);  // 3000 unknowns
 }
 
 TEST(SparseLdltTest, SolvesSizeOneAndThree) {
@@ -124,7 +102,7 @@ TEST(SparseLdltTest, SolvesSizeOneAndThree) {
 }
 
 TEST(SparseLdltTest, UpperTriangleInputEqualsFullInput) {
-  const SparseMatrix A = MakeTetBlockSpd(2, 2, 1, 10);
+  const SparseMatrix A = testing::MakeRandomTetBlockSpd(2, 2, 1, 10);
   const SparseMatrix U = A.triangularView<Eigen::Upper>();
   SparseLdlt full, upper;
   full.Analyze(A);
@@ -140,7 +118,7 @@ TEST(SparseLdltTest, UpperTriangleInputEqualsFullInput) {
 }
 
 TEST(SparseLdltTest, OrderingAndFillMatchEigenSimplicialLdlt) {
-  const SparseMatrix A = MakeTetBlockSpd(4, 3, 3, 12);
+  const SparseMatrix A = testing::MakeRandomTetBlockSpd(4, 3, 3, 12);
   SparseLdlt ldlt;
   ldlt.Analyze(A);
   Eigen::SimplicialLDLT<SparseMatrix> eigen_ldlt(A);
@@ -156,7 +134,7 @@ TEST(SparseLdltTest, OrderingAndFillMatchEigenSimplicialLdlt) {
 }
 
 TEST(SparseLdltTest, RefactorizesWithNewValuesOnSamePattern) {
-  SparseMatrix A = MakeTetBlockSpd(3, 3, 2, 13);
+  SparseMatrix A = testing::MakeRandomTetBlockSpd(3, 3, 2, 13);
   SparseLdlt ldlt;
   ldlt.Analyze(A);
   ASSERT_TRUE(ldlt.Factorize(A));
@@ -164,7 +142,7 @@ TEST(SparseLdltTest, RefactorizesWithNewValuesOnSamePattern) {
   VecX x_old = b;
   ldlt.Solve(x_old);
   // New values, same pattern: written through the value array, as the body does.
-  const SparseMatrix A_new = MakeTetBlockSpd(3, 3, 2, 15);
+  const SparseMatrix A_new = testing::MakeRandomTetBlockSpd(3, 3, 2, 15);
   ASSERT_EQ(A_new.nonZeros(), A.nonZeros());
   std::copy(A_new.valuePtr(), A_new.valuePtr() + A_new.nonZeros(), A.valuePtr());
   ASSERT_TRUE(ldlt.Factorize(A));
@@ -176,7 +154,7 @@ TEST(SparseLdltTest, RefactorizesWithNewValuesOnSamePattern) {
 }
 
 TEST(SparseLdltTest, SolveColumnsEqualsColumnByColumnSolve) {
-  const SparseMatrix A = MakeTetBlockSpd(3, 3, 3, 16);
+  const SparseMatrix A = testing::MakeRandomTetBlockSpd(3, 3, 3, 16);
   const int n = static_cast<int>(A.rows());
   SparseLdlt ldlt;
   ldlt.Analyze(A);
@@ -210,7 +188,7 @@ TEST(SparseLdltTest, SolveColumnsEqualsColumnByColumnSolve) {
 TEST(SparseLdltTest, CountsNegativePivotsOfIndefiniteMatrix) {
   // Random symmetric pattern with a diagonal of mixed sign: negative pivots = negative eigenvalues.
   for (unsigned seed = 20; seed < 25; ++seed) {
-    SparseMatrix A = MakeTetBlockSpd(2, 2, 2, seed);
+    SparseMatrix A = testing::MakeRandomTetBlockSpd(2, 2, 2, seed);
     const int n = static_cast<int>(A.rows());
     std::mt19937 rng(seed);
     for (int i = 0; i < n; ++i)
@@ -280,7 +258,7 @@ TEST(SparseLdltTest, RejectsBadInput) {
 }
 
 TEST(SparseLdltTest, FactorizeAndSolveDoNotAllocate) {
-  SparseMatrix A = MakeTetBlockSpd(4, 4, 3, 30);
+  SparseMatrix A = testing::MakeRandomTetBlockSpd(4, 4, 3, 30);
   const int n = static_cast<int>(A.rows());
   SparseLdlt ldlt;
   ldlt.Analyze(A);

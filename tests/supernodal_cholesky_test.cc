@@ -10,35 +10,12 @@
 
 #include "plugin/box_tet_mesher.h"
 #include "plugin/sparse_ldlt.h"
+#include "tests/tet_block_spd.h"
 
 namespace taut {
 namespace {
 
 using SnSparse = SparseLdlt::SparseMatrix;
-
-// M + K with the 3x3-block pattern of an nx x ny x nz box tet mesh (K: random PSD 12x12 element
-// matrices B^T B; M: a positive diagonal in [0.1, 1.1]), full symmetric CSC.
-SnSparse MakeSnTetSystem(int nx, int ny, int nz, unsigned seed) {
-  const TetMesh mesh = MakeBoxTetMesh(Vec3(1, 0.5, 0.5), nx, ny, nz);
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-1.0, 1.0);
-  const int n = 3 * static_cast<int>(mesh.nodes.size());
-  std::vector<Eigen::Triplet<double>> t;
-  for (const auto& tet : mesh.tets) {
-    const Mat12 B = Mat12::NullaryExpr([&] { return u(rng); });
-    const Mat12 K_e = B.transpose() * B;
-    for (int a = 0; a < 4; ++a)
-      for (int b = 0; b < 4; ++b)
-        for (int r = 0; r < 3; ++r)
-          for (int c = 0; c < 3; ++c)
-            t.emplace_back(3 * tet[a] + r, 3 * tet[b] + c, K_e(3 * a + r, 3 * b + c));
-  }
-  for (int i = 0; i < n; ++i) t.emplace_back(i, i, 0.6 + 0.5 * u(rng));
-  SnSparse A(n, n);
-  A.setFromTriplets(t.begin(), t.end());
-  A.makeCompressed();
-  return A;
-}
 
 MatX MakeSnRhs(int n, int cols, unsigned seed) {
   std::mt19937 rng(seed);
@@ -71,14 +48,15 @@ void ExpectKernelsAgree(const SnSparse& A, int num_rhs) {
 }
 
 TEST(SupernodalCholeskyTest, SolvesLikeTheUpLookingKernel) {
-  ExpectKernelsAgree(MakeSnTetSystem(2, 1, 1, 1), 1);    // a few supernodes
-  ExpectKernelsAgree(MakeSnTetSystem(8, 3, 3, 2), 5);    // 432 unknowns
-  ExpectKernelsAgree(MakeSnTetSystem(14, 4, 4, 3), 37);  // 16 + 16 + 5 columns per pass
+  ExpectKernelsAgree(testing::MakeRandomTetBlockSpd(2, 1, 1, 1), 1);  // a few supernodes
+  ExpectKernelsAgree(testing::MakeRandomTetBlockSpd(8, 3, 3, 2), 5);  // 432 unknowns
+  ExpectKernelsAgree(testing::MakeRandomTetBlockSpd(14, 4, 4, 3),
+                     37);  // 16 + 16 + 5 columns per pass
 }
 
 TEST(SupernodalCholeskyTest, AutoKernelFollowsTheFactorWork) {
-  const SnSparse small = MakeSnTetSystem(3, 2, 2, 4);
-  const SnSparse large = MakeSnTetSystem(20, 5, 5, 5);
+  const SnSparse small = testing::MakeRandomTetBlockSpd(3, 2, 2, 4);
+  const SnSparse large = testing::MakeRandomTetBlockSpd(20, 5, 5, 5);
   SparseLdlt a, b;
   a.Analyze(small);
   b.Analyze(large);
@@ -89,7 +67,7 @@ TEST(SupernodalCholeskyTest, AutoKernelFollowsTheFactorWork) {
 }
 
 TEST(SupernodalCholeskyTest, RefactorsNewValuesOnTheSamePattern) {
-  SnSparse A = MakeSnTetSystem(6, 3, 2, 6);
+  SnSparse A = testing::MakeRandomTetBlockSpd(6, 3, 2, 6);
   SparseLdlt sn;
   sn.Analyze(A, SparseLdlt::Kernel::kSupernodal);
   ASSERT_TRUE(sn.Factorize(A));
@@ -104,7 +82,7 @@ TEST(SupernodalCholeskyTest, RefactorsNewValuesOnTheSamePattern) {
 }
 
 TEST(SupernodalCholeskyTest, FailsOnAMatrixThatIsNotPositiveDefinite) {
-  SnSparse A = MakeSnTetSystem(6, 3, 2, 9);
+  SnSparse A = testing::MakeRandomTetBlockSpd(6, 3, 2, 9);
   const SnSparse A_spd = A;
   // Shifting by -1.0 I takes the diagonal mass below zero on some DOFs: A is indefinite.
   for (int k = 0; k < A.outerSize(); ++k)
