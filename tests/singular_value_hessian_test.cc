@@ -20,7 +20,7 @@
 namespace taut {
 namespace {
 
-const double kInf = std::numeric_limits<double>::infinity();
+const double kHessianInf = std::numeric_limits<double>::infinity();
 constexpr StrainProjection kAllModes[] = {
     StrainProjection::kHyperbolic, StrainProjection::kOrthogonal,
     StrainProjection::kLinearInterpolation, StrainProjection::kEllipsoid};
@@ -116,7 +116,7 @@ TEST(SingularValueHessianTest, NodeAssemblyMatchesFdOfTheRowJacobian) {
   std::mt19937 rng(3);
   StrainLimitSettings settings = StrainLimitSettings::Isotropic(0.9, 1.1);
   settings.svd_gap_epsilon = 0.0;
-  settings.activation_margin = kInf;
+  settings.activation_margin = kHessianInf;
   const StrainLimitParams params = CalcStrainLimitParams(settings);
   double worst = 0.0;
   int checked = 0;
@@ -184,9 +184,9 @@ TEST(SingularValueHessianTest, ClampedCurvatureIsPsdAndBounded) {
   int checked = 0;
   for (const StrainProjection mode : kAllModes) {
     StrainLimitSettings settings =
-        StrainLimitSettings::PerAxis(Vec3(0.8, 0.0, 0.9), Vec3(1.05, 1.3, kInf), mode);
-    settings.activation_margin = kInf;
-    settings.hyperbolic_row_band = kInf;
+        StrainLimitSettings::PerAxis(Vec3(0.8, 0.0, 0.9), Vec3(1.05, 1.3, kHessianInf), mode);
+    settings.activation_margin = kHessianInf;
+    settings.hyperbolic_row_band = kHessianInf;
     settings.svd_gap_epsilon = 1e-2;  // a coarse clamp: active for most of the deltas below
     const StrainLimitParams params = CalcStrainLimitParams(settings);
     for (int trial = 0; trial < 300; ++trial) {
