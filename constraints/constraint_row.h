@@ -10,21 +10,13 @@
 
 #include "constraints/island_body.h"
 #include "constraints/row_key.h"
+#include "constraints/row_types.h"
 #include "plugin/deformable_body.h"
 
 namespace taut {
 
 // Largest number of nodes one row touches (a hex, or an embedded point with trilinear weights).
 constexpr int kMaxRowNodes = 8;
-
-// What a row constrains, for statistics.
-enum class RowType : std::uint8_t {
-  kStrainLimit,
-  kEnergyLimit,
-  kContact,       // deformable against rigid or deformable (normal and friction rows)
-  kRigidContact,  // Bullet's rigid-rigid contact inside a deformable island
-  kJoint,         // Bullet joint rows and node attachments (bilateral)
-};
 
 // C(x) >= 0 linearized at the current iterate: C + J dx >= 0 (docs/math.md §5.3), or C = 0 for a
 // bilateral row. J is sparse over at most two island bodies ("sides"): the nodes of side A

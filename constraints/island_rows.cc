@@ -89,11 +89,7 @@ void IslandRows::CountTypes(StepStats& stats) const {
     return static_cast<int>(std::count_if(rows_.begin(), rows_.end(),
                                           [type](const auto& r) { return r.type == type; }));
   };
-  stats.rows_strain = count(RowType::kStrainLimit);
-  stats.rows_energy = count(RowType::kEnergyLimit);
-  stats.rows_contact = count(RowType::kContact);
-  stats.rows_rigid_contact = count(RowType::kRigidContact);
-  stats.rows_joint = count(RowType::kJoint);
+  for (const RowTypeInfo& info : kRowTypes) stats.rows_of(info.type) = count(info.type);
 }
 
 double IslandRows::CalcRowVelocity(int c, const std::vector<VecX>& v) const {

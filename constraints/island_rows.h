@@ -16,9 +16,7 @@ namespace taut {
 using KeyedMultipliers = std::vector<std::pair<std::uint64_t, double>>;
 
 // True for rows whose C is a fraction of a limit (strain, energy); the others are distances [m].
-inline bool IsLimitRow(const ConstraintRow& row) {
-  return row.type == RowType::kStrainLimit || row.type == RowType::kEnergyLimit;
-}
+inline bool IsLimitRow(const ConstraintRow& row) { return GetRowTypeInfo(row.type).is_limit; }
 
 class IslandRows {
  public:

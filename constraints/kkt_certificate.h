@@ -10,7 +10,6 @@
 
 namespace taut {
 
-constexpr int kNumRowTypes = 5;  // RowType values
 
 // Residuals at an iterate. Distance rows (contacts, joints) count in limit-row units, i.e. times
 // violation_tolerance / contact_tolerance, so one tolerance applies to every row.

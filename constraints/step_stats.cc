@@ -2,18 +2,40 @@
 
 #include <algorithm>
 
+#include "plugin/common.h"
+
 namespace taut {
+
+int& StepStats::rows_of(RowType type) {
+  switch (type) {
+    case RowType::kStrainLimit:
+      return rows_strain;
+    case RowType::kEnergyLimit:
+      return rows_energy;
+    case RowType::kContact:
+      return rows_contact;
+    case RowType::kRigidContact:
+      return rows_rigid_contact;
+    case RowType::kJoint:
+      return rows_joint;
+  }
+  TAUT_ASSERT(false);
+  return rows_joint;
+}
+
+int StepStats::rows_total() const {
+  int total = 0;
+  for (const RowTypeInfo& info : kRowTypes) total += rows_of(info.type);
+  return total;
+}
+
 namespace {
 
 // total += part for the constraint work that adds up over islands and over substeps.
 void AddWork(const StepStats& part, StepStats& total) {
   total.ms_rows += part.ms_rows;
   total.ms_solve += part.ms_solve;
-  total.rows_strain += part.rows_strain;
-  total.rows_energy += part.rows_energy;
-  total.rows_contact += part.rows_contact;
-  total.rows_rigid_contact += part.rows_rigid_contact;
-  total.rows_joint += part.rows_joint;
+  for (const RowTypeInfo& info : kRowTypes) total.rows_of(info.type) += part.rows_of(info.type);
   total.pgs_sweeps += part.pgs_sweeps;
   total.restoration_iterations += part.restoration_iterations;
   total.active_set_solves += part.active_set_solves;
@@ -35,7 +57,7 @@ void KeepWorst(const StepStats& part, StepStats& worst) {
   worst.kkt_primal = std::max(worst.kkt_primal, part.kkt_primal);
   worst.kkt_complementarity = std::max(worst.kkt_complementarity, part.kkt_complementarity);
   worst.kkt_dual = std::max(worst.kkt_dual, part.kkt_dual);
-  for (int i = 0; i < 5; ++i) {
+  for (int i = 0; i < kNumRowTypes; ++i) {
     worst.kkt_primal_by_type[i] = std::max(worst.kkt_primal_by_type[i], part.kkt_primal_by_type[i]);
     worst.kkt_complementarity_by_type[i] =
         std::max(worst.kkt_complementarity_by_type[i], part.kkt_complementarity_by_type[i]);

@@ -2,6 +2,8 @@
 // and how the figures of islands and of substeps add up.
 #pragma once
 
+#include "constraints/row_types.h"
+
 namespace taut {
 
 // What one world substep did and how long each stage took (docs/architecture.md §3, stage 8).
@@ -59,8 +61,8 @@ struct StepStats {
   double kkt_complementarity = 0.0;  // |C| of pushing rows, slip of sticking contacts, C units
   double kkt_dual = 0.0;             // distance of lambda from its set, relative to max |lambda|
   // The first two by row type (RowType order: strain, energy, contact, rigid contact, joint).
-  double kkt_primal_by_type[5] = {0, 0, 0, 0, 0};
-  double kkt_complementarity_by_type[5] = {0, 0, 0, 0, 0};
+  double kkt_primal_by_type[kNumRowTypes] = {0, 0, 0, 0, 0};
+  double kkt_complementarity_by_type[kNumRowTypes] = {0, 0, 0, 0, 0};
 
   int islands = 0;               // islands solved by the SQP (with at least one row source)
   int rigid_bodies_coupled = 0;  // dynamic rigid bodies solved inside deformable islands
@@ -68,9 +70,11 @@ struct StepStats {
   // stepSimulation call (AddSubstepStats, DeformableWorld::last_call_stats).
   int substeps = 1;
 
-  int rows_total() const {
-    return rows_strain + rows_energy + rows_contact + rows_rigid_contact + rows_joint;
-  }
+  // The active-row counter of `type` (rows_strain, ... in kRowTypes order).
+  int& rows_of(RowType type);
+  int rows_of(RowType type) const { return const_cast<StepStats&>(*this).rows_of(type); }
+  // Active rows of every type.
+  int rows_total() const;
 };
 
 // Adds one island's SQP statistics to those of its substep `step`: row and solve times [ms] and

@@ -45,9 +45,10 @@ int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::strin
   scene->world().SetThreadCount(ThreadCount());
   std::ofstream csv(out_dir + "/steps.csv");
   csv.precision(17);
-  csv << "step,time_s,ms_step,ms_unconstrained,ms_rows,ms_solve,ms_rigid,rows_strain,"
-         "rows_energy,rows_contact,rows_rigid_contact,rows_joint,islands,rigid_bodies_coupled,pgs_"
-         "sweeps,sqp_iterations,restoration_iterations,active_set_solves,"
+  csv << "step,time_s,ms_step,ms_unconstrained,ms_rows,ms_solve,ms_rigid";
+  for (const taut::RowTypeInfo& info : taut::kRowTypes) csv << ",rows_" << info.name;
+  csv << ",islands,rigid_bodies_coupled,pgs_sweeps,sqp_iterations,restoration_iterations,"
+         "active_set_solves,"
          "violation_before,violation_after,stationarity,converged,islands_dual,islands_primal,"
          "newton_iterations,pcg_iterations,kkt_primal,kkt_complementarity,kkt_dual";
   for (const std::string& column : scene->CsvColumns()) csv << "," << column;
@@ -79,9 +80,9 @@ int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::strin
     total_sweeps += s.pgs_sweeps;
     max_violation = std::max(max_violation, s.violation_after);
     csv << step << "," << step * dt << "," << ms << "," << s.ms_unconstrained << "," << s.ms_rows
-        << "," << s.ms_solve << "," << s.ms_rigid << "," << s.rows_strain << "," << s.rows_energy
-        << "," << s.rows_contact << "," << s.rows_rigid_contact << "," << s.rows_joint << ","
-        << s.islands << "," << s.rigid_bodies_coupled << "," << s.pgs_sweeps << ","
+        << "," << s.ms_solve << "," << s.ms_rigid;
+    for (const taut::RowTypeInfo& info : taut::kRowTypes) csv << "," << s.rows_of(info.type);
+    csv << "," << s.islands << "," << s.rigid_bodies_coupled << "," << s.pgs_sweeps << ","
         << s.sqp_iterations << "," << s.restoration_iterations << "," << s.active_set_solves << ","
         << s.violation_before << "," << s.violation_after << "," << s.stationarity << ","
         << (s.converged ? 1 : 0) << "," << s.islands_dual << "," << s.islands_primal << ","
