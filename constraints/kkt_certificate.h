@@ -10,7 +10,6 @@
 
 namespace taut {
 
-
 // Residuals at an iterate. Distance rows (contacts, joints) count in limit-row units, i.e. times
 // violation_tolerance / contact_tolerance, so one tolerance applies to every row.
 struct KktResiduals {
