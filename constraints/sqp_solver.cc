@@ -132,34 +132,12 @@ void SqpSolver::Solve(double h, const std::vector<DeformableBody*>& bodies,
 void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
                       const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
                       StepStats& stats) {
-  const size_t nb = bodies.size();
-  x_.resize(nb);
-  v_k_.resize(nb);
   const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
-  v_qp_.resize(nb);
-  v_trial_.resize(nb);
-  dv_.resize(nb);
-  for (size_t b = 0; b < nb; ++b) v_k_[b] = bodies[b]->v();
-  columns_.Clear();  // this step's A
-  if (settings.warm_start) {
-    iterate_ = previous_;
-  } else {
-    iterate_.clear();
-  }
+  BeginSolve(bodies, settings);
   double rho = 0.0, last_alpha = 1.0;
   bool restoring = false;
-  full_rows_at_v_k_ = false;
   for (int k = 0;; ++k) {
-    double violation = full_violation_;
-    if (full_rows_at_v_k_) {
-      // A certificate step moved v_k to v_QP exactly: its rows are already collected there.
-      std::swap(rows_, full_rows_);
-      full_rows_at_v_k_ = false;
-    } else {
-      const auto t_rows = std::chrono::steady_clock::now();
-      violation = rows_.Collect(h, bodies, sources, v_k_, distance_scale);
-      stats.ms_rows += MsSince(t_rows);
-    }
+    const double violation = CollectRowsAtIterate(h, bodies, sources, distance_scale, stats);
     if (k == 0) stats.violation_before = violation;
     stats.violation_after = violation;
     rows_.CountTypes(stats);
@@ -190,97 +168,153 @@ void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
       restoring = true;
     }
     const auto t_solve = std::chrono::steady_clock::now();
-    BuildDelassus(bodies);
-    // q = C(x_k)/h + J_k (v* - v_k).
-    const int m = rows_.size();
-    q_.resize(m);
-    for (int c = 0; c < m; ++c) {
-      const ConstraintRow& row = rows_[c];
-      double jdv = 0.0;
-      row.ForEachEntry([&](int body, int block, const Vec3& J) {
-        jdv +=
-            J.dot(bodies[body]->v_star().segment<3>(3 * block) - v_k_[body].segment<3>(3 * block));
-      });
-      q_[c] = restoring ? row.C / h : row.C / h + jdv;
-      // Friction rows: w_t = J_t v = J_t (v* + Y lambda), so q = J_t v* (restoration: 0).
-      if (row.friction_of > 0) q_[c] = restoring ? 0.0 : jdv + rows_.CalcRowVelocity(c, v_k_);
-    }
-    BuildPgsRows();
+    BuildQp(h, bodies, restoring);
+    SolveQp(settings, stats);
+    CalcQpVelocities(bodies, restoring);
     if (restoring) {
-      lambda_qp_.setZero(m);
+      TakeRestorationStep(h, bodies, sources, settings, stats);
     } else {
-      lambda_qp_ = lambda_;
+      last_alpha = TakeMeritStep(h, bodies, sources, settings, kkt, rho, stats);
     }
-    PgsSettings pgs_settings = settings.pgs;
-    pgs_settings.validate_input = false;  // rows built here: W symmetric by construction
-    pgs_settings.w_workspace = &w_;
-    const PgsStats pgs = SolvePgs(W_, q_, pgs_rows_, lambda_qp_, pgs_settings);
-    stats.pgs_sweeps += pgs.sweeps;
-    stats.lcp_residual = pgs.residual;
-    if (settings.polish_active_set && pgs.residual > settings.polish.tolerance) {
-      stats.active_set_solves++;
-      stats.lcp_residual = PolishActiveSet(W_, q_, pgs_rows_, lambda_qp_, settings.pgs,
-                                           settings.polish, &stats.pgs_sweeps);
-    }
-    // v_QP = v* + Y lambda_QP (restoration: v_k + Y dlambda).
-    for (size_t b = 0; b < nb; ++b) {
-      v_qp_[b] = restoring ? v_k_[b] : bodies[b]->v_star();
-      const std::vector<int>& rows = rows_.body_rows(static_cast<int>(b));
-      const MatX& Y = columns_.Y(static_cast<int>(b));
-      for (size_t i = 0; i < rows.size(); ++i) v_qp_[b] += Y.col(i) * lambda_qp_[rows[i]];
-    }
-    if (restoring) {
-      // Accept the push only as far as it lowers the total violation (halving, as the merit).
-      const double before = CalcViolationSum(h, bodies, sources, v_k_);
-      double alpha = 1.0;
-      for (int halving = 0; halving < settings.max_line_search_halvings; ++halving) {
-        for (size_t b = 0; b < nb; ++b) v_trial_[b] = v_k_[b] + alpha * (v_qp_[b] - v_k_[b]);
-        if (CalcViolationSum(h, bodies, sources, v_trial_) < before) break;
-        alpha *= 0.5;
-      }
-      for (size_t b = 0; b < nb; ++b) v_k_[b] += alpha * (v_qp_[b] - v_k_[b]);
-      lambda_ += alpha * lambda_qp_;
-      rows_.Store(lambda_, iterate_);
-      stats.restoration_iterations++;
-      stats.sqp_iterations = k + 1;
-      stats.ms_solve += MsSince(t_solve);
-      continue;
-    }
-    // Merit backtracking.
-    rho = std::max(rho, 2.0 * lambda_qp_.cwiseAbs().maxCoeff());
-    const double phi_k = CalcMerit(h, bodies, sources, v_k_, rho);
-    for (size_t b = 0; b < nb; ++b) dv_[b] = v_qp_[b] - v_k_[b];
-    const double step_norm = EnergyNormSquared(bodies, dv_, scratch_);
-    double alpha = 1.0;
-    const double residual_k =
-        CalcCertificateResidual(kkt, settings.violation_tolerance, settings.stationarity_tolerance);
-    bool certificate_step = false;
-    for (int halving = 0; halving < settings.max_line_search_halvings; ++halving) {
-      for (size_t b = 0; b < nb; ++b) v_trial_[b] = v_k_[b] + alpha * (v_qp_[b] - v_k_[b]);
-      if (CalcMerit(h, bodies, sources, v_trial_, rho) <= phi_k - 1e-4 * alpha * step_norm) break;
-      certificate_step =
-          halving == 0 && settings.certificate_steps &&
-          AcceptFullStep(h, bodies, sources, settings, residual_k, kkt.max_primal(), stats);
-      if (certificate_step) break;
-      alpha *= 0.5;
-    }
-    if (certificate_step) {
-      // (v_QP, lambda_QP) exactly, so the next iteration takes the rows just collected there.
-      v_k_ = v_qp_;
-      lambda_ = lambda_qp_;
-      full_rows_at_v_k_ = true;
-    } else {
-      for (size_t b = 0; b < nb; ++b) v_k_[b] += alpha * (v_qp_[b] - v_k_[b]);
-      lambda_ += alpha * (lambda_qp_ - lambda_);
-    }
-    last_alpha = alpha;
     rows_.Store(lambda_, iterate_);
     stats.sqp_iterations = k + 1;
     stats.ms_solve += MsSince(t_solve);
   }
-  for (size_t b = 0; b < nb; ++b) bodies[b]->set_v(v_k_[b]);
+  for (size_t b = 0; b < bodies.size(); ++b) bodies[b]->set_v(v_k_[b]);
   rows_.Store(lambda_, previous_);
   stats.islands_dual++;
+}
+
+void SqpSolver::BeginSolve(const std::vector<IslandBody*>& bodies, const SqpSettings& settings) {
+  const size_t nb = bodies.size();
+  x_.resize(nb);
+  v_k_.resize(nb);
+  v_qp_.resize(nb);
+  v_trial_.resize(nb);
+  dv_.resize(nb);
+  for (size_t b = 0; b < nb; ++b) v_k_[b] = bodies[b]->v();
+  columns_.Clear();  // this step's A
+  if (settings.warm_start) {
+    iterate_ = previous_;
+  } else {
+    iterate_.clear();
+  }
+  full_rows_at_v_k_ = false;
+}
+
+double SqpSolver::CollectRowsAtIterate(double h, const std::vector<IslandBody*>& bodies,
+                                       const std::vector<ConstraintSource*>& sources,
+                                       double distance_scale, StepStats& stats) {
+  if (full_rows_at_v_k_) {
+    // A certificate step moved v_k to v_QP exactly: its rows are already collected there.
+    std::swap(rows_, full_rows_);
+    full_rows_at_v_k_ = false;
+    return full_violation_;
+  }
+  const auto t_rows = std::chrono::steady_clock::now();
+  const double violation = rows_.Collect(h, bodies, sources, v_k_, distance_scale);
+  stats.ms_rows += MsSince(t_rows);
+  return violation;
+}
+
+void SqpSolver::BuildQp(double h, const std::vector<IslandBody*>& bodies, bool restoring) {
+  BuildDelassus(bodies);
+  // q = C(x_k)/h + J_k (v* - v_k).
+  const int m = rows_.size();
+  q_.resize(m);
+  for (int c = 0; c < m; ++c) {
+    const ConstraintRow& row = rows_[c];
+    double jdv = 0.0;
+    row.ForEachEntry([&](int body, int block, const Vec3& J) {
+      jdv += J.dot(bodies[body]->v_star().segment<3>(3 * block) - v_k_[body].segment<3>(3 * block));
+    });
+    q_[c] = restoring ? row.C / h : row.C / h + jdv;
+    // Friction rows: w_t = J_t v = J_t (v* + Y lambda), so q = J_t v* (restoration: 0).
+    if (row.friction_of > 0) q_[c] = restoring ? 0.0 : jdv + rows_.CalcRowVelocity(c, v_k_);
+  }
+  BuildPgsRows();
+  if (restoring) {
+    lambda_qp_.setZero(m);
+  } else {
+    lambda_qp_ = lambda_;
+  }
+}
+
+void SqpSolver::SolveQp(const SqpSettings& settings, StepStats& stats) {
+  PgsSettings pgs_settings = settings.pgs;
+  pgs_settings.validate_input = false;  // rows built here: W symmetric by construction
+  pgs_settings.w_workspace = &w_;
+  const PgsStats pgs = SolvePgs(W_, q_, pgs_rows_, lambda_qp_, pgs_settings);
+  stats.pgs_sweeps += pgs.sweeps;
+  stats.lcp_residual = pgs.residual;
+  if (settings.polish_active_set && pgs.residual > settings.polish.tolerance) {
+    stats.active_set_solves++;
+    stats.lcp_residual = PolishActiveSet(W_, q_, pgs_rows_, lambda_qp_, settings.pgs,
+                                         settings.polish, &stats.pgs_sweeps);
+  }
+}
+
+// v_QP = v* + Y lambda_QP (restoration: v_k + Y dlambda).
+void SqpSolver::CalcQpVelocities(const std::vector<IslandBody*>& bodies, bool restoring) {
+  for (size_t b = 0; b < bodies.size(); ++b) {
+    v_qp_[b] = restoring ? v_k_[b] : bodies[b]->v_star();
+    const std::vector<int>& rows = rows_.body_rows(static_cast<int>(b));
+    const MatX& Y = columns_.Y(static_cast<int>(b));
+    for (size_t i = 0; i < rows.size(); ++i) v_qp_[b] += Y.col(i) * lambda_qp_[rows[i]];
+  }
+}
+
+// Accepts the push only as far as it lowers the total violation (halving, as the merit).
+void SqpSolver::TakeRestorationStep(double h, const std::vector<IslandBody*>& bodies,
+                                    const std::vector<ConstraintSource*>& sources,
+                                    const SqpSettings& settings, StepStats& stats) {
+  const size_t nb = bodies.size();
+  const double before = CalcViolationSum(h, bodies, sources, v_k_);
+  double alpha = 1.0;
+  for (int halving = 0; halving < settings.max_line_search_halvings; ++halving) {
+    for (size_t b = 0; b < nb; ++b) v_trial_[b] = v_k_[b] + alpha * (v_qp_[b] - v_k_[b]);
+    if (CalcViolationSum(h, bodies, sources, v_trial_) < before) break;
+    alpha *= 0.5;
+  }
+  for (size_t b = 0; b < nb; ++b) v_k_[b] += alpha * (v_qp_[b] - v_k_[b]);
+  lambda_ += alpha * lambda_qp_;
+  stats.restoration_iterations++;
+}
+
+// Merit backtracking from (v_k, lambda_k) towards (v_QP, lambda_QP), or the full step taken on its
+// own certificate (AcceptFullStep). Returns the step length.
+double SqpSolver::TakeMeritStep(double h, const std::vector<IslandBody*>& bodies,
+                                const std::vector<ConstraintSource*>& sources,
+                                const SqpSettings& settings, const KktResiduals& kkt, double& rho,
+                                StepStats& stats) {
+  const size_t nb = bodies.size();
+  rho = std::max(rho, 2.0 * lambda_qp_.cwiseAbs().maxCoeff());
+  const double phi_k = CalcMerit(h, bodies, sources, v_k_, rho);
+  for (size_t b = 0; b < nb; ++b) dv_[b] = v_qp_[b] - v_k_[b];
+  const double step_norm = EnergyNormSquared(bodies, dv_, scratch_);
+  double alpha = 1.0;
+  const double residual_k =
+      CalcCertificateResidual(kkt, settings.violation_tolerance, settings.stationarity_tolerance);
+  bool certificate_step = false;
+  for (int halving = 0; halving < settings.max_line_search_halvings; ++halving) {
+    for (size_t b = 0; b < nb; ++b) v_trial_[b] = v_k_[b] + alpha * (v_qp_[b] - v_k_[b]);
+    if (CalcMerit(h, bodies, sources, v_trial_, rho) <= phi_k - 1e-4 * alpha * step_norm) break;
+    certificate_step =
+        halving == 0 && settings.certificate_steps &&
+        AcceptFullStep(h, bodies, sources, settings, residual_k, kkt.max_primal(), stats);
+    if (certificate_step) break;
+    alpha *= 0.5;
+  }
+  if (certificate_step) {
+    // (v_QP, lambda_QP) exactly, so the next iteration takes the rows just collected there.
+    v_k_ = v_qp_;
+    lambda_ = lambda_qp_;
+    full_rows_at_v_k_ = true;
+  } else {
+    for (size_t b = 0; b < nb; ++b) v_k_[b] += alpha * (v_qp_[b] - v_k_[b]);
+    lambda_ += alpha * (lambda_qp_ - lambda_);
+  }
+  return alpha;
 }
 
 }  // namespace taut

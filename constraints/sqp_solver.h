@@ -44,6 +44,28 @@ class SqpSolver {
  private:
   // Positions x_b of every body at velocities v (into x_).
   void CalcPositions(double h, const std::vector<IslandBody*>& bodies, const std::vector<VecX>& v);
+  // The stages of Solve, in order. Per-step set-up: sizes, v_k = v*, warm starts, no kept columns.
+  void BeginSolve(const std::vector<IslandBody*>& bodies, const SqpSettings& settings);
+  // Rows at x_k = x0 + h v_k (or those a certificate step collected there); returns their
+  // largest violation.
+  double CollectRowsAtIterate(double h, const std::vector<IslandBody*>& bodies,
+                              const std::vector<ConstraintSource*>& sources, double distance_scale,
+                              StepStats& stats);
+  // The QP at the iterate: W, q = C/h + J (v* - v_k) (restoration: C/h), the PGS rows and the
+  // starting lambda_QP.
+  void BuildQp(double h, const std::vector<IslandBody*>& bodies, bool restoring);
+  // lambda_QP by one PGS (and the active-set polish where PGS left a residual).
+  void SolveQp(const SqpSettings& settings, StepStats& stats);
+  // v_QP from lambda_QP.
+  void CalcQpVelocities(const std::vector<IslandBody*>& bodies, bool restoring);
+  // Restoration: v_k, lambda_k pushed towards v_QP as far as the violation drops.
+  void TakeRestorationStep(double h, const std::vector<IslandBody*>& bodies,
+                           const std::vector<ConstraintSource*>& sources,
+                           const SqpSettings& settings, StepStats& stats);
+  // The merit line search (or certificate step) to the next iterate; returns the step length.
+  double TakeMeritStep(double h, const std::vector<IslandBody*>& bodies,
+                       const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
+                       const KktResiduals& kkt, double& rho, StepStats& stats);
   // Y_b = A_b^-1 J_b^T per body and W = J Y.
   void BuildDelassus(const std::vector<IslandBody*>& bodies);
   // Sum of violations of every source at velocities v (per body).
