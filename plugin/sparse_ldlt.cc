@@ -36,20 +36,23 @@ void SparseLdlt::Analyze(const SparseMatrix& pattern, Kernel kernel) {
   BuildPermutedUpper(pattern);
   CalcEliminationTree();
 
-  // Every buffer the numeric phase and the solves touch, sized once here.
-  const int nnz_l = col_start_[n_];
-  l_row_.assign(nnz_l, 0);
-  l_val_.assign(nnz_l, 0.0);
-  d_.assign(n_, 0.0);
-  d_inv_.assign(n_, 0.0);
-  y_.assign(n_, 0.0);
-  flag_.assign(n_, -1);
-  stack_.assign(n_, 0);
-  col_fill_.assign(n_, 0);
-  work_.assign(static_cast<size_t>(n_) * kMaxBlockColumns, 0.0);
   analyzed_ = true;
   supernodal_ = kernel == Kernel::kSupernodal ||
                 (kernel == Kernel::kAuto && CalcFactorWork() >= kSupernodalMinWork);
+
+  // Every buffer the numeric phase and the solves touch, sized once here; the up-looking
+  // kernel's L and row workspace only when that kernel runs (the supernodal one keeps its panels).
+  const int nnz_l = supernodal_ ? 0 : col_start_[n_];
+  const int n_up = supernodal_ ? 0 : n_;
+  l_row_.assign(nnz_l, 0);
+  l_val_.assign(nnz_l, 0.0);
+  d_.assign(n_, 0.0);
+  d_inv_.assign(n_up, 0.0);
+  y_.assign(n_up, 0.0);
+  flag_.assign(n_up, -1);
+  stack_.assign(n_up, 0);
+  col_fill_.assign(n_up, 0);
+  work_.assign(static_cast<size_t>(n_) * kMaxBlockColumns, 0.0);
   supernodal_factor_ = SupernodalCholesky();
   if (supernodal_) supernodal_factor_.Analyze(n_, c_start_, c_row_, c_source_, parent_, col_start_);
 }
@@ -131,7 +134,6 @@ bool SparseLdlt::Factorize(const SparseMatrix& A) {
       return false;
     }
     supernodal_factor_.CalcPivots(d_);
-    for (int k = 0; k < n_; ++k) d_inv_[k] = 1.0 / d_[k];
     factorized_ = true;
     return true;
   }

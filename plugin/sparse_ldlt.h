@@ -54,7 +54,8 @@ class SparseLdlt {
   bool supernodal() const { return supernodal_; }
 
   // Numeric phase on a matrix with the analysed pattern (same outer index and nonzero count; the
-  // row indices are compared in debug builds). No heap allocation. Returns false when a pivot is
+  // row indices are compared in debug builds). No heap allocation (the supernodal kernel's dense
+  // products allocate a few work blocks). Returns false when a pivot is
   // zero or not finite; failed_column() then names the column of A. Throws InputError when called
   // before Analyze or with a different size or nonzero count.
   bool Factorize(const SparseMatrix& A);
