@@ -62,6 +62,54 @@ const btCollisionObject* FindPartnerObject(std::uint64_t key,
   return objects[index];
 }
 
+// Stage: a deformable pair's contact (kDeformableContactRowKey: side A's point on side B's
+// triangle) and its mirror on side B.
+void AppendDeformablePair(const ConstraintRow& row, const DeformableBody* partner,
+                          DeformableContactPoint contact, SubstepForces& forces) {
+  const auto fields = UnpackRowKeyPayload(kDeformableContactRowKey, RowKeyPayload(row.key));
+  contact.point = static_cast<int>(fields[1]);
+  contact.partner_body = partner;
+  DeformableContactPoint mirror = contact;
+  mirror.body = partner;
+  mirror.partner_body = contact.body;
+  mirror.point = mirror.node = -1;
+  mirror.triangle = static_cast<int>(fields[2]);
+  mirror.normal = -contact.normal;
+  mirror.friction_impulse = -contact.friction_impulse;
+  mirror.force = -contact.force;
+  forces.contacts.push_back(contact);
+  forces.contacts.push_back(mirror);
+}
+
+// Stage: a rigid partner's contact (kRigidContactRowKey: a contact point, or a face contact on a
+// triangle) of normal row c, and the wrench it puts on that rigid object.
+void AppendRigidPartner(const IslandRows& rows, const VecX& lambda, int c,
+                        const RigidIslandBody* dynamic, const btCollisionObjectArray& objects,
+                        DeformableContactPoint contact, SubstepForces& forces) {
+  const auto fields = UnpackRowKeyPayload(kRigidContactRowKey, RowKeyPayload(rows[c].key));
+  (fields[3] >= kRigidFaceRowOffset ? contact.triangle : contact.point) =
+      static_cast<int>(fields[0]);
+  contact.partner_object =
+      dynamic != nullptr ? dynamic->rigid() : FindPartnerObject(rows[c].key, objects);
+  forces.contacts.push_back(contact);
+  if (contact.partner_object == nullptr) return;
+  RigidBodyWrench& wrench = FindWrench(forces, contact.partner_object);
+  wrench.num_contacts++;
+  if (dynamic != nullptr) {
+    // The solve's own side B: J_lin = -d, J_ang = -(q - com) x d.
+    for (int k = 0; k <= 2 && c + k < rows.size() && (k == 0 || rows[c + k].friction_of == k); ++k)
+      AddRigidSide(rows[c + k], lambda[c + k], forces.h, wrench);
+    return;
+  }
+  // Immovable partner: -F at its surface point q = p - gap n, about its centre of mass.
+  const btTransform& transform = contact.partner_object->getWorldTransform();
+  const Vec3 com = ToEigen(wrench.rigid != nullptr ? wrench.rigid->getCenterOfMassPosition()
+                                                   : transform.getOrigin());
+  const Vec3 q = contact.position - contact.gap * contact.normal;
+  wrench.force -= contact.force;
+  wrench.torque -= (q - com).cross(contact.force);
+}
+
 // Stage: the contact of normal row c (tangent rows c + 1, c + 2) on side A's body, its mirror on
 // a deformable side B, and the wrench on a rigid side B.
 void AppendContact(const std::vector<IslandBody*>& bodies, const IslandRows& rows,
@@ -87,46 +135,10 @@ void AppendContact(const std::vector<IslandBody*>& bodies, const IslandRows& row
   const IslandBody* side_b = row.body2 >= 0 ? bodies[row.body2] : nullptr;
   const DeformableBody* partner = side_b != nullptr ? side_b->deformable() : nullptr;
   if (partner != nullptr) {
-    // Deformable pair (kDeformableContactRowKey): side A's point on side B's triangle.
-    const auto fields = UnpackRowKeyPayload(kDeformableContactRowKey, RowKeyPayload(row.key));
-    contact.point = static_cast<int>(fields[1]);
-    contact.partner_body = partner;
-    DeformableContactPoint mirror = contact;
-    mirror.body = partner;
-    mirror.partner_body = contact.body;
-    mirror.point = mirror.node = -1;
-    mirror.triangle = static_cast<int>(fields[2]);
-    mirror.normal = -contact.normal;
-    mirror.friction_impulse = -contact.friction_impulse;
-    mirror.force = -contact.force;
-    forces.contacts.push_back(contact);
-    forces.contacts.push_back(mirror);
+    AppendDeformablePair(row, partner, contact, forces);
     return;
   }
-  // Rigid partner (kRigidContactRowKey): a contact point, or a face contact on a triangle.
-  const auto fields = UnpackRowKeyPayload(kRigidContactRowKey, RowKeyPayload(row.key));
-  (fields[3] >= kRigidFaceRowOffset ? contact.triangle : contact.point) =
-      static_cast<int>(fields[0]);
-  const RigidIslandBody* dynamic = AsRigid(side_b);
-  contact.partner_object =
-      dynamic != nullptr ? dynamic->rigid() : FindPartnerObject(row.key, objects);
-  forces.contacts.push_back(contact);
-  if (contact.partner_object == nullptr) return;
-  RigidBodyWrench& wrench = FindWrench(forces, contact.partner_object);
-  wrench.num_contacts++;
-  if (dynamic != nullptr) {
-    // The solve's own side B: J_lin = -d, J_ang = -(q - com) x d.
-    for (int k = 0; k <= 2 && c + k < rows.size() && (k == 0 || rows[c + k].friction_of == k); ++k)
-      AddRigidSide(rows[c + k], lambda[c + k], h, wrench);
-    return;
-  }
-  // Immovable partner: -F at its surface point q = p - gap n, about its centre of mass.
-  const btTransform& transform = contact.partner_object->getWorldTransform();
-  const Vec3 com = ToEigen(wrench.rigid != nullptr ? wrench.rigid->getCenterOfMassPosition()
-                                                   : transform.getOrigin());
-  const Vec3 q = contact.position - contact.gap * contact.normal;
-  wrench.force -= contact.force;
-  wrench.torque -= (q - com).cross(contact.force);
+  AppendRigidPartner(rows, lambda, c, AsRigid(side_b), objects, contact, forces);
 }
 
 // Stage: a strain- or energy-limit row with its multiplier.

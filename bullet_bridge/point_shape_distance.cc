@@ -237,6 +237,67 @@ bool CalcPolyhedronInsideDistance(const Vec3& p, const btPolyhedralConvexShape& 
 
 }  // namespace internal
 
+namespace {
+
+// Stage: the analytic shapes (plane, sphere, capsule, box, cylinder) at local point p; false for
+// any other shape type.
+bool CalcAnalyticLocalContact(const Vec3& p, const btCollisionShape& shape, LocalContact& out) {
+  switch (shape.getShapeType()) {
+    case STATIC_PLANE_PROXYTYPE:
+      out = CalcPlane(p, static_cast<const btStaticPlaneShape&>(shape));
+      return true;
+    case SPHERE_SHAPE_PROXYTYPE:
+      out = CalcRoundedSegment(p, 2, 0.0, static_cast<const btSphereShape&>(shape).getRadius());
+      return true;
+    case CAPSULE_SHAPE_PROXYTYPE: {
+      const auto& capsule = static_cast<const btCapsuleShape&>(shape);
+      out =
+          CalcRoundedSegment(p, capsule.getUpAxis(), capsule.getHalfHeight(), capsule.getRadius());
+      return true;
+    }
+    case BOX_SHAPE_PROXYTYPE:
+      out = CalcBox(p, ToEigen(static_cast<const btBoxShape&>(shape).getHalfExtentsWithMargin()));
+      return true;
+    case CYLINDER_SHAPE_PROXYTYPE: {
+      const auto& cylinder = static_cast<const btCylinderShape&>(shape);
+      const int axis = cylinder.getUpAxis();
+      const Vec3 h = ToEigen(cylinder.getHalfExtentsWithMargin());
+      out = CalcCylinder(p, axis, h[CylinderRadiusIndex(axis)], h[axis]);
+      return true;
+    }
+    default:
+      return false;
+  }
+}
+
+// Stage: any other convex shape (inside a polyhedron by its face planes, else GJK/EPA) or a
+// concave mesh (its closest triangle among those overlapping the box p ± max_distance).
+PointContact CalcGeneralShapeContact(const Vec3& point, const Vec3& p,
+                                     const btCollisionShape& shape, const btTransform& transform,
+                                     double max_distance) {
+  LocalContact local;
+  if (shape.isPolyhedral() && internal::CalcPolyhedronInsideDistance(
+                                  p, static_cast<const btPolyhedralConvexShape&>(shape), local)) {
+    return ToWorld(local, transform);
+  }
+  if (shape.isConvex()) {
+    return internal::CalcGjkPointDistance(point, static_cast<const btConvexShape&>(shape),
+                                          transform);
+  }
+  TAUT_DEMAND(shape.isConcave(), "CalcPointShapeDistance: unsupported Bullet shape type ",
+              shape.getShapeType(), " (", shape.getName(), ")");
+  ClosestTriangleCallback callback(p);
+  const btVector3 r(max_distance, max_distance, max_distance);
+  static_cast<const btConcaveShape&>(shape).processAllTriangles(&callback, ToBullet(p) - r,
+                                                                ToBullet(p) + r);
+  if (callback.Result(&local)) return ToWorld(local, transform);
+  PointContact none;
+  none.gap = std::numeric_limits<double>::infinity();
+  return none;
+}
+
+}  // namespace
+
 PointContact CalcPointShapeDistance(const Vec3& point, const btCollisionShape& shape,
                                     const btTransform& transform, double max_distance) {
   TAUT_DEMAND(max_distance >= 0.0, "CalcPointShapeDistance: max_distance must be >= 0, got ",
@@ -249,69 +310,21 @@ PointContact CalcPointShapeDistance(const Vec3& point, const btCollisionShape& s
     return none;
   }
   const Vec3 p = ToEigen(transform.invXform(ToBullet(point)));
-  PointContact result;
-  switch (type) {
-    case STATIC_PLANE_PROXYTYPE:
-      result = ToWorld(CalcPlane(p, static_cast<const btStaticPlaneShape&>(shape)), transform);
-      break;
-    case SPHERE_SHAPE_PROXYTYPE: {
-      const auto& sphere = static_cast<const btSphereShape&>(shape);
-      result = ToWorld(CalcRoundedSegment(p, 2, 0.0, sphere.getRadius()), transform);
-      break;
+  PointContact result = none;
+  LocalContact local;
+  if (CalcAnalyticLocalContact(p, shape, local)) {
+    result = ToWorld(local, transform);
+  } else if (type == COMPOUND_SHAPE_PROXYTYPE) {
+    // Union: the child with the smallest gap.
+    const auto& compound = static_cast<const btCompoundShape&>(shape);
+    for (int i = 0; i < compound.getNumChildShapes(); ++i) {
+      const PointContact child =
+          CalcPointShapeDistance(point, *compound.getChildShape(i),
+                                 transform * compound.getChildTransform(i), max_distance);
+      if (child.valid && (!result.valid || child.gap < result.gap)) result = child;
     }
-    case CAPSULE_SHAPE_PROXYTYPE: {
-      const auto& capsule = static_cast<const btCapsuleShape&>(shape);
-      result = ToWorld(
-          CalcRoundedSegment(p, capsule.getUpAxis(), capsule.getHalfHeight(), capsule.getRadius()),
-          transform);
-      break;
-    }
-    case BOX_SHAPE_PROXYTYPE: {
-      const auto& box = static_cast<const btBoxShape&>(shape);
-      result = ToWorld(CalcBox(p, ToEigen(box.getHalfExtentsWithMargin())), transform);
-      break;
-    }
-    case CYLINDER_SHAPE_PROXYTYPE: {
-      const auto& cylinder = static_cast<const btCylinderShape&>(shape);
-      const int axis = cylinder.getUpAxis();
-      const Vec3 h = ToEigen(cylinder.getHalfExtentsWithMargin());
-      result = ToWorld(CalcCylinder(p, axis, h[CylinderRadiusIndex(axis)], h[axis]), transform);
-      break;
-    }
-    case COMPOUND_SHAPE_PROXYTYPE: {
-      // Union: the child with the smallest gap.
-      const auto& compound = static_cast<const btCompoundShape&>(shape);
-      result = none;
-      for (int i = 0; i < compound.getNumChildShapes(); ++i) {
-        const PointContact child =
-            CalcPointShapeDistance(point, *compound.getChildShape(i),
-                                   transform * compound.getChildTransform(i), max_distance);
-        if (child.valid && (!result.valid || child.gap < result.gap)) result = child;
-      }
-      break;
-    }
-    default: {
-      LocalContact inside;
-      if (shape.isPolyhedral() &&
-          internal::CalcPolyhedronInsideDistance(
-              p, static_cast<const btPolyhedralConvexShape&>(shape), inside)) {
-        result = ToWorld(inside, transform);
-      } else if (shape.isConvex()) {
-        result = internal::CalcGjkPointDistance(point, static_cast<const btConvexShape&>(shape),
-                                                transform);
-      } else if (shape.isConcave()) {
-        // Triangles overlapping the box p ± max_distance (local frame).
-        ClosestTriangleCallback callback(p);
-        const btVector3 r(max_distance, max_distance, max_distance);
-        static_cast<const btConcaveShape&>(shape).processAllTriangles(&callback, ToBullet(p) - r,
-                                                                      ToBullet(p) + r);
-        LocalContact local;
-        result = callback.Result(&local) ? ToWorld(local, transform) : none;
-      } else {
-        TAUT_DEMAND(false, "CalcPointShapeDistance: unsupported Bullet shape type ", type, " (",
-                    shape.getName(), ")");
-      }
-    }
+  } else {
+    result = CalcGeneralShapeContact(point, p, shape, transform, max_distance);
   }
   if (!result.valid || result.gap > max_distance) return none;
   return result;

@@ -65,12 +65,51 @@ struct Sweep {
     Set(c, next[0]);
     Set(p, next[1]);
   }
+  // One sweep: every row in index order, a disk pair at its first row; delta = the sweep's
+  // largest W_cc |Delta lambda_c|.
+  void SweepRows() {
+    delta = 0.0;
+    for (int c = 0; c < static_cast<int>(rows.size()); ++c) {
+      const PgsRow& row = rows[c];
+      if (row.kind == RowKind::kFriction && row.cone == FrictionCone::kDisk && row.partner >= 0) {
+        if (c < row.partner) UpdateDiskPair(c, row.partner, row.mu, lambda[row.normal]);
+        continue;
+      }
+      if (IsSkipped(c)) continue;
+      if (row.kind == RowKind::kFriction) {  // box cone or single tangential row
+        const double radius = CalcCoulombRadius(row.mu, lambda[row.normal]);
+        UpdateBoxRow(c, -radius, radius);
+      } else {
+        UpdateBoxRow(c, row.lo, row.hi);
+      }
+    }
+  }
 };
 
 // Value of a skipped row: the point of its feasible set nearest 0 (W_cc ~ 0 means lambda_c
 // barely moves w, so any larger value is unjustified).
 double CalcSkippedValue(const PgsRow& row) {
   return row.kind == RowKind::kFriction ? 0.0 : ClampToBox(0.0, row.lo, row.hi);
+}
+
+// Stage: skipped rows set once to their value; returns their count.
+int SetSkippedRows(Sweep& sweep) {
+  int skipped = 0;
+  for (int c = 0; c < static_cast<int>(sweep.rows.size()); ++c) {
+    if (!sweep.IsSkipped(c)) continue;
+    ++skipped;
+    sweep.lambda[c] = CalcSkippedValue(sweep.rows[c]);
+  }
+  return skipped;
+}
+
+// Stage: incremental w = W lambda + q, one product now, then a column update per changed
+// multiplier.
+VecX& InitIncrementalW(const Sweep& sweep, VecX& w) {
+  w.resize(sweep.q.size());
+  w.noalias() = sweep.W * sweep.lambda;
+  w += sweep.q;
+  return w;
 }
 
 }  // namespace
@@ -85,40 +124,14 @@ PgsStats SolvePgs(const MatX& W, const VecX& q, const std::vector<PgsRow>& rows,
     stats.converged = true;
     return stats;
   }
-  // Prepare: skip threshold relative to the largest diagonal; skipped rows set once.
-  const double max_diagonal = W.diagonal().maxCoeff();
-  Sweep sweep{W, q, rows, lambda, settings.relaxation, settings.min_diagonal * max_diagonal};
-  for (int c = 0; c < m; ++c) {
-    if (!sweep.IsSkipped(c)) continue;
-    ++stats.skipped_rows;
-    lambda[c] = CalcSkippedValue(rows[c]);
-  }
-  if (settings.w_workspace != nullptr) {
-    // Incremental w: one product now, then a column update per changed multiplier.
-    VecX& w = *settings.w_workspace;
-    w.resize(m);
-    w.noalias() = W * lambda;
-    w += q;
-    sweep.w = &w;
-  }
+  // Prepare: skip threshold relative to the largest diagonal.
+  Sweep sweep{
+      W, q, rows, lambda, settings.relaxation, settings.min_diagonal * W.diagonal().maxCoeff()};
+  stats.skipped_rows = SetSkippedRows(sweep);
+  if (settings.w_workspace != nullptr) sweep.w = &InitIncrementalW(sweep, *settings.w_workspace);
   bool residual_current = false;
   for (int s = 0; s < settings.max_sweeps; ++s) {
-    // Sweep: every row in index order; a disk pair at its first row.
-    sweep.delta = 0.0;
-    for (int c = 0; c < m; ++c) {
-      const PgsRow& row = rows[c];
-      if (row.kind == RowKind::kFriction && row.cone == FrictionCone::kDisk && row.partner >= 0) {
-        if (c < row.partner) sweep.UpdateDiskPair(c, row.partner, row.mu, lambda[row.normal]);
-        continue;
-      }
-      if (sweep.IsSkipped(c)) continue;
-      if (row.kind == RowKind::kFriction) {  // box cone or single tangential row
-        const double radius = CalcCoulombRadius(row.mu, lambda[row.normal]);
-        sweep.UpdateBoxRow(c, -radius, radius);
-      } else {
-        sweep.UpdateBoxRow(c, row.lo, row.hi);
-      }
-    }
+    sweep.SweepRows();
     // Stop test: velocity-scaled change, then (optionally) the natural-map residual.
     stats.sweeps = s + 1;
     stats.final_delta = sweep.delta;
