@@ -154,6 +154,12 @@ EnergyLimitConstraint* DeformableWorld::SetEnergyLimits(DeformableBody* body,
                        std::make_unique<EnergyLimitConstraint>(*body, limits, next_source_id_++));
 }
 
+NodeHeightSource* DeformableWorld::SetNodeHeightLimit(DeformableBody* body, double z_min) {
+  FindEntry(body);
+  return ReplaceSource(body, std::make_unique<NodeHeightSource>(
+                                 *body, z_min, body->settings().contact_margin, next_source_id_++));
+}
+
 RigidIslandBody* DeformableWorld::FindRigidIslandBody(btRigidBody* rigid) {
   auto& slot = rigid_bodies_[rigid];
   if (slot == nullptr) slot = std::make_unique<RigidIslandBody>(rigid);

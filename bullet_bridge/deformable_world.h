@@ -23,6 +23,7 @@
 #include "constraints/deformable_island_body.h"
 #include "constraints/energy_limit_constraint.h"
 #include "constraints/island_solver.h"
+#include "constraints/node_height_source.h"
 #include "constraints/step_stats.h"
 #include "constraints/strain_limit_constraint.h"
 #include "plugin/hex_element_model.h"
@@ -84,6 +85,12 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   // C = 1 - U_e/U_max).
   // Replaces earlier energy limits of the body; throws InputError for invalid settings.
   EnergyLimitConstraint* SetEnergyLimits(DeformableBody* body, const EnergyLimitSettings& limits);
+  // Keeps every free node of `body` at or above the world height z_min [m]: one unilateral row
+  // C_i = z_i - z_min >= 0 per free node within the body's contact_margin of it (a floor no
+  // Bullet object stands for; constraints/node_height_source.h). Replaces an earlier height limit
+  // of the body; ClearLimits removes it. Throws InputError for a body not in this world or a
+  // z_min that is not finite.
+  NodeHeightSource* SetNodeHeightLimit(DeformableBody* body, double z_min);
   // Pins `nodes` of `body` to `rigid` at their current offsets in the rigid body's frame (a
   // bone in soft flesh). A static or kinematic rigid body drives the nodes kinematically; a
   // dynamic one is coupled both ways by bilateral rows in the island's solve (it feels the

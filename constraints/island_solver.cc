@@ -44,8 +44,9 @@ void IslandSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     // Measured failure of a limit-only island: the next steps go to the primal path (kAuto
     // only). Islands with contact or joint rows stay dual: there the primal path failed more
     // steps than the dual (finger: 46 vs 23 of 493, docs/report.md).
-    const bool limit_rows_only =
-        stats.rows_contact + stats.rows_rigid_contact + stats.rows_joint == 0;
+    bool limit_rows_only = true;
+    for (const RowTypeInfo& info : kRowTypes)
+      if (!info.is_limit && stats.rows_of(info.type) > 0) limit_rows_only = false;
     if (!stats.converged && limit_rows_only && settings.solver == IslandSolverKind::kAuto) {
       primal_steps_left_ = primal_window_;
       primal_window_ = std::min(2 * primal_window_, kMaxPrimalSteps);

@@ -85,6 +85,13 @@ inline constexpr RowKeyLayout<2> kNodeAttachmentRowKey{
         {"axis", 2},   // world axis 0-2
     }}};
 
+// NodeHeightSource: a free node above the body's height limit (one row per node).
+inline constexpr RowKeyLayout<1> kNodeHeightRowKey{
+    "node height",
+    {{
+        {"node", 31},  // node index in the body (any int >= 0)
+    }}};
+
 static_assert(kStrainLimitRowKey.bits() <= kRowKeyPayloadBits, "strain-limit key too wide");
 static_assert(kStrainLimitRowKey.fields[1].bits + kStrainLimitRowKey.fields[2].bits +
                           kStrainLimitRowKey.fields[3].bits ==
@@ -97,5 +104,6 @@ static_assert(kRigidContactRowKey.bits() <= kRowKeyPayloadBits, "rigid-contact k
 static_assert(kRigidManifoldRowKey.bits() <= kRowKeyPayloadBits, "manifold key too wide");
 static_assert(kJointRowKey.bits() <= kRowKeyPayloadBits, "joint key too wide");
 static_assert(kNodeAttachmentRowKey.bits() <= kRowKeyPayloadBits, "attachment key too wide");
+static_assert(kNodeHeightRowKey.bits() <= kRowKeyPayloadBits, "node-height key too wide");
 
 }  // namespace taut

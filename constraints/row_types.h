@@ -14,8 +14,9 @@ enum class RowType : std::uint8_t {
   kContact,       // deformable against rigid or deformable (normal and friction rows)
   kRigidContact,  // Bullet's rigid-rigid contact inside a deformable island
   kJoint,         // Bullet joint rows and node attachments (bilateral)
+  kNodeHeight,    // a free deformable node above a world height z_min (NodeHeightSource)
 };
-constexpr int kNumRowTypes = 5;
+constexpr int kNumRowTypes = 6;
 
 struct RowTypeInfo {
   RowType type;
@@ -31,6 +32,7 @@ inline constexpr std::array<RowTypeInfo, kNumRowTypes> kRowTypes{{
     {RowType::kContact, "contact", "m (gap along the normal)", false},
     {RowType::kRigidContact, "rigid_contact", "m (Bullet's contact distance)", false},
     {RowType::kJoint, "joint", "m or rad (Bullet's joint error)", false},
+    {RowType::kNodeHeight, "node_height", "m (node height z_i - z_min)", false},
 }};
 
 inline const RowTypeInfo& GetRowTypeInfo(RowType type) { return kRowTypes[static_cast<int>(type)]; }

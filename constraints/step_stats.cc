@@ -18,6 +18,8 @@ int& StepStats::rows_of(RowType type) {
       return rows_rigid_contact;
     case RowType::kJoint:
       return rows_joint;
+    case RowType::kNodeHeight:
+      return rows_node_height;
   }
   TAUT_ASSERT(false);
   return rows_joint;

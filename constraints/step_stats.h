@@ -34,6 +34,7 @@ struct StepStats {
   int rows_contact = 0;            // deformable contact normal + friction rows
   int rows_rigid_contact = 0;      // Bullet rigid-rigid contact rows inside deformable islands
   int rows_joint = 0;              // Bullet joint and node attachment rows (bilateral)
+  int rows_node_height = 0;        // node-height rows (a free node above z_min)
   int pgs_sweeps = 0;              // total over SQP iterations
   int active_set_solves = 0;       // QPs refined by a direct active-set solve
   int sqp_iterations = 0;          // including restoration iterations
@@ -60,9 +61,10 @@ struct StepStats {
   double kkt_primal = 0.0;           // max(0, -C) of every row (distance rows scaled), C units
   double kkt_complementarity = 0.0;  // |C| of pushing rows, slip of sticking contacts, C units
   double kkt_dual = 0.0;             // distance of lambda from its set, relative to max |lambda|
-  // The first two by row type (RowType order: strain, energy, contact, rigid contact, joint).
-  double kkt_primal_by_type[kNumRowTypes] = {0, 0, 0, 0, 0};
-  double kkt_complementarity_by_type[kNumRowTypes] = {0, 0, 0, 0, 0};
+  // The first two by row type (RowType order: strain, energy, contact, rigid contact, joint,
+  // node height).
+  double kkt_primal_by_type[kNumRowTypes] = {0, 0, 0, 0, 0, 0};
+  double kkt_complementarity_by_type[kNumRowTypes] = {0, 0, 0, 0, 0, 0};
 
   int islands = 0;               // islands solved by the SQP (with at least one row source)
   int rigid_bodies_coupled = 0;  // dynamic rigid bodies solved inside deformable islands

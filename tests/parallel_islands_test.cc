@@ -119,7 +119,7 @@ void ExpectSameStepCounts(const StepStats& a, const StepStats& b) {
   EXPECT_TRUE(SameBits(a.kkt_primal, b.kkt_primal));
   EXPECT_TRUE(SameBits(a.kkt_complementarity, b.kkt_complementarity));
   EXPECT_TRUE(SameBits(a.kkt_dual, b.kkt_dual));
-  for (int i = 0; i < 5; ++i) {
+  for (int i = 0; i < kNumRowTypes; ++i) {
     EXPECT_TRUE(SameBits(a.kkt_primal_by_type[i], b.kkt_primal_by_type[i])) << i;
     EXPECT_TRUE(SameBits(a.kkt_complementarity_by_type[i], b.kkt_complementarity_by_type[i])) << i;
   }

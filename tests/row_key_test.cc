@@ -16,6 +16,7 @@
 #include "constraints/deformable_contact_source.h"
 #include "constraints/deformable_island_body.h"
 #include "constraints/energy_limit_constraint.h"
+#include "constraints/node_height_source.h"
 #include "constraints/row_key_layouts.h"
 #include "constraints/strain_limit_constraint.h"
 #include "plugin/box_tet_mesher.h"
@@ -35,6 +36,7 @@ void ForEachLayout(F&& f) {
   f(kRigidManifoldRowKey);
   f(kJointRowKey);
   f(kNodeAttachmentRowKey);
+  f(kNodeHeightRowKey);
 }
 
 // The largest value of a field.
@@ -166,6 +168,7 @@ TEST(RowKeyTest, SourceIdBeyond16BitsThrowsInEveryPackerAndEverySourceConstructo
     ExpectInputError([&] { JointSource source(bad); }, {"joints", id});
     ExpectInputError([&] { NodeAttachmentSource(*a, &bone, {0}, {Vec3::Zero()}, bad); },
                      {"node attachment", id});
+    ExpectInputError([&] { NodeHeightSource(*a, 0.0, 0.01, bad); }, {"node height", id});
   }
 }
 

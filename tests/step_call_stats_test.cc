@@ -49,7 +49,7 @@ StepStats MakeStats(int seed, bool converged) {
   double* worst[] = {&s.violation_before, &s.violation_after,     &s.stationarity, &s.lcp_residual,
                      &s.kkt_primal,       &s.kkt_complementarity, &s.kkt_dual};
   for (int k = 0; k < 7; ++k) *worst[k] = (k % 2 == seed % 2) ? 1e-3 * (k + 1) : 1e-6 * (k + 1);
-  for (int i = 0; i < 5; ++i) {
+  for (int i = 0; i < kNumRowTypes; ++i) {
     s.kkt_primal_by_type[i] = (i % 2 == seed % 2) ? 2e-3 : 2e-6;
     s.kkt_complementarity_by_type[i] = (i % 2 == seed % 2) ? 3e-6 : 3e-3;
   }
@@ -100,7 +100,7 @@ TEST(StepStatsMergeTest, SubstepsAddTimesAndCountsAndKeepTheWorstResiduals) {
   EXPECT_EQ(call.kkt_primal, std::max(a.kkt_primal, b.kkt_primal));
   EXPECT_EQ(call.kkt_complementarity, std::max(a.kkt_complementarity, b.kkt_complementarity));
   EXPECT_EQ(call.kkt_dual, std::max(a.kkt_dual, b.kkt_dual));
-  for (int i = 0; i < 5; ++i) {
+  for (int i = 0; i < kNumRowTypes; ++i) {
     EXPECT_EQ(call.kkt_primal_by_type[i], 2e-3);
     EXPECT_EQ(call.kkt_complementarity_by_type[i], 3e-3);
   }
