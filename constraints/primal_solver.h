@@ -78,6 +78,10 @@ class PrimalSolver {
   bool TakeNewtonStep(double h, const std::vector<IslandBody*>& bodies,
                       const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
                       StepStats& stats);
+  // Whether (v, Proj(y(v))) at the rows collected at v passes the certificate (the inner loop's
+  // early stop, PrimalSettings::stop_newton_on_certificate); leaves lambda_ = Proj(y(v)).
+  bool IsNewtonIterateCertified(const std::vector<IslandBody*>& bodies, double h,
+                                const SqpSettings& settings);
   // lambda_c = Proj_c(y_c(v)) and D_c at v (row velocities jv_ = J v).
   void CalcProjectedMultipliers();
   // grad = A(v - v*) - J^T lambda on free blocks.

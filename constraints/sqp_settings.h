@@ -26,9 +26,13 @@ struct PrimalSettings {
   double penalty_growth = 3.0;
   double max_penalty_growth = 10.0;
   double newton_tolerance = 1e-9;  // stop when the Newton decrement < this * ||v - v*||_A^2
-  int max_pcg_iterations = 200;    // coupled islands: PCG on the Newton step
-  double pcg_tolerance = 1e-10;    // relative residual of that PCG
-  bool curvature = true;           // lagged row curvature G in the model and H
+  // ... or as soon as (v, Proj(y(v))) passes the step's certificate after a Newton step, with
+  // distance rows (contacts, joints) held to newton_stop_distance_factor of their tolerance.
+  bool stop_newton_on_certificate = true;
+  double newton_stop_distance_factor = 0.1;
+  int max_pcg_iterations = 200;  // coupled islands: PCG on the Newton step
+  double pcg_tolerance = 1e-10;  // relative residual of that PCG
+  bool curvature = true;         // lagged row curvature G in the model and H
   // Factor reuse: a body whose H costs more than min_refactor_cost preconditioned CG iterations
   // to factor keeps its last factor (from an earlier Newton iteration or step) as the
   // preconditioner of CG on the exact H, to stale_pcg_tolerance, while CG needs fewer than half
