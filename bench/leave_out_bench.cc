@@ -6,7 +6,7 @@
 #include <chrono>
 
 #include "constraints/deformable_island_body.h"
-#include "constraints/strain_limit_constraint.h"
+#include "constraints/strain_limit_source.h"
 #include "demos/scenes/bullet_world_holder.h"
 #include "plugin/box_tet_mesher.h"
 
@@ -87,10 +87,10 @@ void BM_LeaveOut_IsotropicVsPerAxisRows(benchmark::State& state) {
   StrainLimitSettings per_axis =
       StrainLimitSettings::PerAxis(Vec3(0.9, 0.8, 0.7), Vec3(1.1, 1.2, 1.3));
   isotropic.activation_margin = per_axis.activation_margin = HUGE_VAL;
-  StrainLimitConstraint iso(body, isotropic, 1), aniso(body, per_axis, 2);
+  StrainLimitSource iso(body, isotropic, 1), aniso(body, per_axis, 2);
   std::vector<ConstraintRow> rows;
   struct Eval {
-    StrainLimitConstraint& source;
+    StrainLimitSource& source;
     const VecX& x;
     std::vector<ConstraintRow>& rows;
     void Step() {

@@ -69,9 +69,9 @@ struct RigidBodyWrench {
 
 // What a limit row bounds.
 enum class LimitRowKind : std::uint8_t {
-  kStrainMin,  // a principal stretch's lower limit (StrainLimitConstraint)
+  kStrainMin,  // a principal stretch's lower limit (StrainLimitSource)
   kStrainMax,  // a principal stretch's upper limit
-  kEnergy,     // the element's elastic energy U_e <= U_max (EnergyLimitConstraint)
+  kEnergy,     // the element's elastic energy U_e <= U_max (EnergyLimitSource)
 };
 
 // One strain- or energy-limit row the solve held (every row collected at its final velocities:

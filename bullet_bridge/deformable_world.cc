@@ -140,18 +140,16 @@ T* DeformableWorld::ReplaceSource(DeformableBody* body, std::unique_ptr<T> sourc
   return result;
 }
 
-StrainLimitConstraint* DeformableWorld::SetStrainLimits(DeformableBody* body,
-                                                        const StrainLimitSettings& limits) {
+StrainLimitSource* DeformableWorld::SetStrainLimits(DeformableBody* body,
+                                                    const StrainLimitSettings& limits) {
   FindEntry(body);  // names a foreign body before anything is built
-  return ReplaceSource(body,
-                       std::make_unique<StrainLimitConstraint>(*body, limits, next_source_id_++));
+  return ReplaceSource(body, std::make_unique<StrainLimitSource>(*body, limits, next_source_id_++));
 }
 
-EnergyLimitConstraint* DeformableWorld::SetEnergyLimits(DeformableBody* body,
-                                                        const EnergyLimitSettings& limits) {
+EnergyLimitSource* DeformableWorld::SetEnergyLimits(DeformableBody* body,
+                                                    const EnergyLimitSettings& limits) {
   FindEntry(body);
-  return ReplaceSource(body,
-                       std::make_unique<EnergyLimitConstraint>(*body, limits, next_source_id_++));
+  return ReplaceSource(body, std::make_unique<EnergyLimitSource>(*body, limits, next_source_id_++));
 }
 
 NodeHeightSource* DeformableWorld::SetNodeHeightLimit(DeformableBody* body, double z_min) {

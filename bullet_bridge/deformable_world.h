@@ -21,11 +21,11 @@
 #include "bullet_bridge/world_snapshot.h"
 #include "constraints/deformable_contact_source.h"
 #include "constraints/deformable_island_body.h"
-#include "constraints/energy_limit_constraint.h"
+#include "constraints/energy_limit_source.h"
 #include "constraints/island_solver.h"
 #include "constraints/node_height_source.h"
 #include "constraints/step_stats.h"
-#include "constraints/strain_limit_constraint.h"
+#include "constraints/strain_limit_source.h"
 #include "plugin/hex_element_model.h"
 #include "plugin/tet_mesh.h"
 
@@ -80,11 +80,11 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
 
   // Limits the principal stretches of every tet of `body` (paper A). Replaces earlier strain
   // limits of that body. Throws InputError for invalid settings or a body that is not a tet body.
-  StrainLimitConstraint* SetStrainLimits(DeformableBody* body, const StrainLimitSettings& limits);
+  StrainLimitSource* SetStrainLimits(DeformableBody* body, const StrainLimitSettings& limits);
   // Limits the elastic energy of every element (tet or hex) of `body` to U_max (paper B:
   // C = 1 - U_e/U_max).
   // Replaces earlier energy limits of the body; throws InputError for invalid settings.
-  EnergyLimitConstraint* SetEnergyLimits(DeformableBody* body, const EnergyLimitSettings& limits);
+  EnergyLimitSource* SetEnergyLimits(DeformableBody* body, const EnergyLimitSettings& limits);
   // Keeps every free node of `body` at or above the world height z_min [m]: one unilateral row
   // C_i = z_i - z_min >= 0 per free node within the body's contact_margin of it (a floor no
   // Bullet object stands for; constraints/node_height_source.h). Replaces an earlier height limit

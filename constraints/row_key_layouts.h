@@ -8,7 +8,7 @@
 
 namespace taut {
 
-// StrainLimitConstraint: a row per element, limit axis, matched principal axis and bound.
+// StrainLimitSource: a row per element, limit axis, matched principal axis and bound.
 inline constexpr RowKeyLayout<4> kStrainLimitRowKey{
     "strain limits",
     {{
@@ -26,7 +26,7 @@ inline constexpr std::uint64_t kStrainLimitDirectionBits = ((std::uint64_t{1} <<
 // The payload bits of kStrainLimitRowKey below the element field.
 inline constexpr std::uint64_t kStrainLimitElementShift = 5;
 
-// EnergyLimitConstraint: a row per element (the element in the low bits: key = source | element).
+// EnergyLimitSource: a row per element (the element in the low bits: key = source | element).
 inline constexpr RowKeyLayout<1> kEnergyLimitRowKey{
     "energy limits",
     {{

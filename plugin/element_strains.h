@@ -14,7 +14,7 @@ struct ElementStrain {
   // descending, s[2] < 0 for an inverted element [-]; 1 at rest, 1.1 stretched by 10 %.
   Vec3 principal_stretches = Vec3::Ones();
   // |F q_j| - 1 along limit axis j, q_j the unit column j of the axes given in rest coordinates
-  // (as StrainLimitConstraint::CalcMaxAxisStrain) [-]; 0 at rest.
+  // (as StrainLimitSource::CalcMaxAxisStrain) [-]; 0 at rest.
   Vec3 axis_strains = Vec3::Zero();
   // Co-rotational elastic energy of the element [J], what energy limits bound (U_e <= U_max,e).
   double energy = 0.0;

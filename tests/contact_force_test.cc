@@ -291,7 +291,7 @@ TEST(ContactForceTest, FrictionImpulsesLieInsideTheCoulombCone) {
 
 // max over free DOFs of |A(v - v*) - sum_c J_c^T lambda_c| over max |J^T lambda|: the limit
 // rows' multipliers explain the body's constrained step (no other rows act on it).
-double CalcLimitStationarity(DeformableBody& body, StrainLimitConstraint& limits,
+double CalcLimitStationarity(DeformableBody& body, StrainLimitSource& limits,
                              const std::vector<LimitRowMultiplier>& reported) {
   std::vector<ConstraintRow> rows;
   limits.AppendRows(body.x(), 0, rows);
@@ -332,7 +332,7 @@ TEST(ContactForceTest, LimitMultipliersArePositiveOnlyOnRowsAtTheLimit) {
     DeformableBody* beam = holder.world.AddTetBody(MakeBoxTetMesh(Vec3(0.4, 0.1, 0.1), 4, 1, 1),
                                                    SoftSettings(2e4, 2.0, 0.5));
     beam->FixNodesWhere([](const Vec3& X) { return X.x() < 1e-9; });
-    StrainLimitConstraint* limits =
+    StrainLimitSource* limits =
         holder.world.SetStrainLimits(beam, StrainLimitSettings::Isotropic(0.97, 1.03));
     RunSteps(holder.world, 60);
     const std::vector<LimitRowMultiplier> reported = holder.world.last_limit_multipliers(beam);

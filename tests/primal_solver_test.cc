@@ -22,7 +22,7 @@ namespace {
 struct SaggingBar {
   BulletWorldHolder holder;
   DeformableBody* body = nullptr;
-  StrainLimitConstraint* limit = nullptr;
+  StrainLimitSource* limit = nullptr;
 
   SaggingBar(IslandSolverKind solver, double s_min, double s_max) {
     DeformableBodySettings settings;

@@ -15,10 +15,10 @@
 #include "bullet_bridge/rigid_manifold_source.h"
 #include "constraints/deformable_contact_source.h"
 #include "constraints/deformable_island_body.h"
-#include "constraints/energy_limit_constraint.h"
+#include "constraints/energy_limit_source.h"
 #include "constraints/node_height_source.h"
 #include "constraints/row_key_layouts.h"
-#include "constraints/strain_limit_constraint.h"
+#include "constraints/strain_limit_source.h"
 #include "plugin/box_tet_mesher.h"
 
 namespace taut {
@@ -154,11 +154,10 @@ TEST(RowKeyTest, SourceIdBeyond16BitsThrowsInEveryPackerAndEverySourceConstructo
   RigidIslandBody bone(&rigid);
   for (const int bad : {1 << 16, -1}) {
     const std::string id = "source id " + std::to_string(bad);
+    ExpectInputError([&] { StrainLimitSource(*a, StrainLimitSettings::Isotropic(0.9, 1.1), bad); },
+                     {"strain limits", id});
     ExpectInputError(
-        [&] { StrainLimitConstraint(*a, StrainLimitSettings::Isotropic(0.9, 1.1), bad); },
-        {"strain limits", id});
-    ExpectInputError(
-        [&] { EnergyLimitConstraint(*a, EnergyLimitSettings::PerElementEnergy(1.0), bad); },
+        [&] { EnergyLimitSource(*a, EnergyLimitSettings::PerElementEnergy(1.0), bad); },
         {"energy limits", id});
     ExpectInputError([&] { DeformableContactSource(*a, surface, *b, surface, bad, 0.5, 0.01); },
                      {"deformable contact", id});

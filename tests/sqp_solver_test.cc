@@ -57,7 +57,7 @@ TEST(SqpSolverTest, IsotropicLimitHoldsWhereTheUnlimitedBodyStretchesFar) {
 
 TEST(SqpSolverTest, EnergyLimitThroughTheWorldCapsEveryElement) {
   PulledCube free_cube(2e3), limited(2e3);
-  EnergyLimitConstraint* limit =
+  EnergyLimitSource* limit =
       limited.holder.world.SetEnergyLimits(limited.body, EnergyLimitSettings::EnergyDensity(20.0));
   free_cube.Run(120, 2.0);
   double worst = 0.0;
@@ -79,7 +79,7 @@ TEST(SqpSolverTest, TightOnePercentLimitOnOneKilopascalBodyHolds2000Steps) {
   DeformableBody* body =
       holder.world.AddTetBody(MakeBoxTetMesh(Vec3(0.15, 0.05, 0.05), 3, 1, 1), settings);
   body->FixNodesWhere([](const Vec3& X) { return X.x() < 1e-9; });
-  StrainLimitConstraint* limit =
+  StrainLimitSource* limit =
       holder.world.SetStrainLimits(body, StrainLimitSettings::Isotropic(0.99, 1.01));
   double worst = 0.0;
   int unconverged = 0;

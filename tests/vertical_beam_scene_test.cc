@@ -51,7 +51,7 @@ double MeanSqpIterations(bool frozen, double* worst_violation) {
   const double free = kUnlimitedStretch;
   auto limits = StrainLimitSettings::PerAxis(Vec3(0.95, 0, 0), Vec3(1.05, free, free));
   limits.freeze_frame_jacobian = frozen;
-  StrainLimitConstraint* constraint = holder.world.SetStrainLimits(body, limits);
+  StrainLimitSource* constraint = holder.world.SetStrainLimits(body, limits);
   int constrained_steps = 0, iterations = 0;
   *worst_violation = 0.0;
   for (int step = 0; step < 120; ++step) {

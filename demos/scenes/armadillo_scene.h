@@ -33,7 +33,7 @@ class ArmadilloScene : public Scene {
   double max_energy_ratio(int b) const { return max_ratio_[b]; }
 
  private:
-  std::vector<EnergyLimitConstraint*> limits_;
+  std::vector<EnergyLimitSource*> limits_;
   std::vector<double> rest_height_, max_flattening_, deepest_, max_ratio_;
   double key_flattening_ = 0.0;
 };

@@ -36,7 +36,7 @@ class BoxOnSphereScene : public Scene {
 
  private:
   std::vector<btRigidBody*> boxes_;
-  EnergyLimitConstraint* limit_ = nullptr;
+  EnergyLimitSource* limit_ = nullptr;
   double max_tilt_ = 0.0, max_penetration_ = 0.0, max_ratio_ = 0.0;
   int max_rigid_rows_ = 0;
   double key_flattening_ = 0.0;

@@ -37,7 +37,7 @@ CollapsingSphereScene::CollapsingSphereScene(const std::vector<Sphere>& spheres,
                                 body, EnergyLimitSettings::PerElementEnergy(*spheres[s].u_max))
                           : nullptr);
     // U_e/U_max of every sphere, against its own limit or the paper's 50 J.
-    meters_.push_back(std::make_unique<EnergyLimitConstraint>(
+    meters_.push_back(std::make_unique<EnergyLimitSource>(
         *body, EnergyLimitSettings::PerElementEnergy(spheres[s].u_max.value_or(kMeterEnergy)),
         kMeterSourceId));
     double lo, hi;

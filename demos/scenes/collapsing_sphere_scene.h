@@ -59,8 +59,8 @@ class CollapsingSphereScene : public Scene {
 
   bool limited(int s) const { return limits_[s] != nullptr; }
 
-  std::vector<EnergyLimitConstraint*> limits_;                  // world's limits, or null
-  std::vector<std::unique_ptr<EnergyLimitConstraint>> meters_;  // U_e/U_max of every sphere
+  std::vector<EnergyLimitSource*> limits_;                  // world's limits, or null
+  std::vector<std::unique_ptr<EnergyLimitSource>> meters_;  // U_e/U_max of every sphere
   std::vector<double> rest_extent_, max_flattening_, max_ratio_, min_volume_ratio_, deepest_;
   int steps_ = 0;
   double ms_sum_ = 0.0;

@@ -39,7 +39,7 @@ class FallingSphereScene : public Scene {
   double max_energy_ratio(int s) const { return max_ratio_[s]; }
 
  private:
-  std::vector<EnergyLimitConstraint*> limits_;
+  std::vector<EnergyLimitSource*> limits_;
   std::vector<bool> landed_;
   std::vector<double> max_flattening_, bounce_, deepest_, max_ratio_;
   double key_flattening_ = 0.0;

@@ -156,7 +156,7 @@ class FingerScene : public Scene {
   // State of the current press.
   int current_ = -1;
   DeformableBody* finger_ = nullptr;
-  StrainLimitConstraint* limits_ = nullptr;
+  StrainLimitSource* limits_ = nullptr;
   Mat3 rotation_ = Mat3::Identity();  // body frame -> world
   Vec3 offset_ = Vec3::Zero();        // body origin in the world at zero travel [m]
   double time_ = 0.0;                 // time since the press began [s]

@@ -32,7 +32,7 @@ HexBeamScene::HexBeamScene(const std::vector<Beam>& beams, double cell_size) {
     lattice->source = beams[b].name;
     DeformableBody* body = world().AddHexBody(lattice, beams[b].settings);
     body->FixNodesWhere([](const Vec3& X) { return X.x() < 1e-9; });
-    EnergyLimitConstraint* limits = nullptr;
+    EnergyLimitSource* limits = nullptr;
     if (beams[b].u_max)
       limits =
           world().SetEnergyLimits(body, EnergyLimitSettings::PerElementEnergy(*beams[b].u_max));

@@ -48,12 +48,12 @@ class HexBeamScene : public Scene {
   double max_tip_displacement(int b) const { return max_tip_[b]; }
 
  private:
-  std::vector<std::vector<int>> tip_nodes_;     // (num_beams) nodes at x = L
-  std::vector<EnergyLimitConstraint*> limits_;  // (num_beams) null: unlimited
-  std::vector<double> max_ratio_;               // (num_beams) over the run
-  std::vector<double> max_energy_;              // (num_beams) max_e U_e over the run [J]
-  std::vector<double> max_tip_;                 // (num_beams) max |tip displacement| [m]
-  double key_sag_ = 0.0;                        // largest sag of the key frames so far [m]
+  std::vector<std::vector<int>> tip_nodes_;  // (num_beams) nodes at x = L
+  std::vector<EnergyLimitSource*> limits_;   // (num_beams) null: unlimited
+  std::vector<double> max_ratio_;            // (num_beams) over the run
+  std::vector<double> max_energy_;           // (num_beams) max_e U_e over the run [J]
+  std::vector<double> max_tip_;              // (num_beams) max |tip displacement| [m]
+  double key_sag_ = 0.0;                     // largest sag of the key frames so far [m]
 };
 
 }  // namespace taut

@@ -35,7 +35,7 @@ class VerticalBeamScene : public Scene {
 
  private:
   std::vector<StrainProjection> modes_;
-  std::vector<StrainLimitConstraint*> limits_;
+  std::vector<StrainLimitSource*> limits_;
   std::vector<std::vector<int>> top_nodes_;
   std::vector<int> first_violation_;
   std::vector<double> max_strain_;

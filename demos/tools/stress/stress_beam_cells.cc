@@ -43,8 +43,8 @@ void RunBeamCell(const BeamParams& params, CellResult& result) {
   std::vector<int> tip;
   for (int i = 0; i < beam->num_nodes(); ++i)
     if (beam->model().rest_positions()[3 * i] > (1.0 - 1e-9) * length) tip.push_back(i);
-  StrainLimitConstraint* strain = nullptr;
-  EnergyLimitConstraint* energy = nullptr;
+  StrainLimitSource* strain = nullptr;
+  EnergyLimitSource* energy = nullptr;
   if (params.strain_limit > 0.0)
     strain = holder.world.SetStrainLimits(
         beam, StrainLimitSettings::Isotropic(1.0 - params.strain_limit, 1.0 + params.strain_limit));

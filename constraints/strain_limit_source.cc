@@ -1,4 +1,4 @@
-#include "constraints/strain_limit_constraint.h"
+#include "constraints/strain_limit_source.h"
 
 #include <algorithm>
 #include <cmath>
@@ -18,8 +18,8 @@ const TetElementModel& AsTets(const DeformableBody& body) {
 }
 }  // namespace
 
-StrainLimitConstraint::StrainLimitConstraint(const DeformableBody& body,
-                                             const StrainLimitSettings& settings, int source_id)
+StrainLimitSource::StrainLimitSource(const DeformableBody& body,
+                                     const StrainLimitSettings& settings, int source_id)
     : body_(body), tets_(AsTets(body)), settings_(settings), key_(kStrainLimitRowKey, source_id) {
   settings_.Validate(tets_.num_elements(), "body '" + body.name() + "' strain limits");
   params_ = CalcStrainLimitParams(settings_);
@@ -35,7 +35,7 @@ StrainLimitConstraint::StrainLimitConstraint(const DeformableBody& body,
   screen_ = screen_ && std::isfinite(slack) && slack > 0.0;
 }
 
-bool StrainLimitConstraint::IsSurelyInactive(const std::array<Vec3, 4>& xe, int e) const {
+bool StrainLimitSource::IsSurelyInactive(const std::array<Vec3, 4>& xe, int e) const {
   if (!screen_) return false;
   // Principal stretches are the square roots of the eigenvalues of F^T F, which lie in the
   // union of its Gershgorin discs; a non-positive det F (inverted) is never screened out.
@@ -52,8 +52,7 @@ bool StrainLimitConstraint::IsSurelyInactive(const std::array<Vec3, 4>& xe, int 
   return lo > 0.0 && stretch_lo_ * stretch_lo_ < lo && hi < stretch_hi_ * stretch_hi_;
 }
 
-int StrainLimitConstraint::AppendRows(const VecX& x, int body_index,
-                                      std::vector<ConstraintRow>& rows) {
+int StrainLimitSource::AppendRows(const VecX& x, int body_index, std::vector<ConstraintRow>& rows) {
   const int before = static_cast<int>(rows.size());
   for (int e = 0; e < tets_.num_elements(); ++e) {
     element_rows_.clear();
@@ -82,9 +81,9 @@ int StrainLimitConstraint::AppendRows(const VecX& x, int body_index,
   return static_cast<int>(rows.size()) - before;
 }
 
-void StrainLimitConstraint::AddIslandCurvature(const IslandIterate& iterate,
-                                               const ConstraintRow* rows, const double* weights,
-                                               int count, CurvatureSink& sink) const {
+void StrainLimitSource::AddIslandCurvature(const IslandIterate& iterate, const ConstraintRow* rows,
+                                           const double* weights, int count,
+                                           CurvatureSink& sink) const {
   // Rows of one element are adjacent: one SVD per element, and sum_c w_c H_c of its rows is
   // scattered once (16 node blocks per element, not per row). Frame-dependent rows sum their
   // full curvature over vec(P) and clamp the element's sum once (docs/math.md §5.9); the others
@@ -125,8 +124,8 @@ void StrainLimitConstraint::AddIslandCurvature(const IslandIterate& iterate,
   flush();
 }
 
-const SignedSvd& StrainLimitConstraint::RememberSvd(int e, const TetPositions& xe,
-                                                    const SignedSvd& svd) {
+const SignedSvd& StrainLimitSource::RememberSvd(int e, const TetPositions& xe,
+                                                const SignedSvd& svd) {
   if (svd_cache_.size() != static_cast<size_t>(tets_.num_elements()))
     svd_cache_.assign(tets_.num_elements(), CachedSvd{});
   CachedSvd& entry = svd_cache_[e];
@@ -136,7 +135,7 @@ const SignedSvd& StrainLimitConstraint::RememberSvd(int e, const TetPositions& x
   return entry.svd;
 }
 
-SignedSvd StrainLimitConstraint::FindOrCalcSvd(int e, const TetPositions& xe) const {
+SignedSvd StrainLimitSource::FindOrCalcSvd(int e, const TetPositions& xe) const {
   // The curvature is evaluated at the positions of the last row collection: the same xe, so the
   // same SVD, bit for bit.
   if (static_cast<size_t>(e) < svd_cache_.size() && svd_cache_[e].valid && svd_cache_[e].x == xe)
@@ -144,27 +143,27 @@ SignedSvd StrainLimitConstraint::FindOrCalcSvd(int e, const TetPositions& xe) co
   return CalcSignedSvd(CalcTetDeformationGradient(tets_.rest().elements[e].r, xe));
 }
 
-double StrainLimitConstraint::CalcElementViolation(const VecX& x, int e) const {
+double StrainLimitSource::CalcElementViolation(const VecX& x, int e) const {
   const auto xe = tets_.GatherElement(x, e);
   if (IsSurelyInactive(xe, e)) return 0.0;
   return CalcStrainLimitViolation(tets_.rest().elements[e].r, xe,
                                   SelectStrainLimitFrame(settings_, e), params_);
 }
 
-double StrainLimitConstraint::CalcMaxViolation(const VecX& x) const {
+double StrainLimitSource::CalcMaxViolation(const VecX& x) const {
   double violation = 0.0;
   for (int e = 0; e < tets_.num_elements(); ++e)
     violation = std::max(violation, CalcElementViolation(x, e));
   return violation;
 }
 
-double StrainLimitConstraint::CalcViolationSum(const VecX& x) const {
+double StrainLimitSource::CalcViolationSum(const VecX& x) const {
   double sum = 0.0;
   for (int e = 0; e < tets_.num_elements(); ++e) sum += CalcElementViolation(x, e);
   return sum;
 }
 
-double StrainLimitConstraint::CalcMaxAxisStrain(const VecX& x, int axis) const {
+double StrainLimitSource::CalcMaxAxisStrain(const VecX& x, int axis) const {
   double strain = -1.0;
   for (int e = 0; e < tets_.num_elements(); ++e) {
     const Vec3 q = SelectStrainLimitFrame(settings_, e).col(axis);

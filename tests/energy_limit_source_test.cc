@@ -1,4 +1,4 @@
-#include "constraints/energy_limit_constraint.h"
+#include "constraints/energy_limit_source.h"
 
 #include <gtest/gtest.h>
 
@@ -61,7 +61,7 @@ double ElementEnergy(const DeformableBody& body, const VecX& x, int e) {
   return CalcTetElementEnergy(tets.rest().elements[e], tets.lame(), tets.GatherElement(x, e));
 }
 
-TEST(EnergyLimitConstraintTest, RowsAreEmittedExactlyBelowTheMargin) {
+TEST(EnergyLimitSourceTest, RowsAreEmittedExactlyBelowTheMargin) {
   auto body = MakeCube(2e3, 2);
   const VecX x = Stretched(*body, 0.1);
   const int num = body->model().num_elements();
@@ -73,7 +73,7 @@ TEST(EnergyLimitConstraintTest, RowsAreEmittedExactlyBelowTheMargin) {
   ASSERT_GT(u_hi, 2.0 * u_lo);
   // U_max between the extremes: some elements violate, some are inside the margin, some not.
   const double u_max = 0.5 * (u_lo + u_hi);
-  EnergyLimitConstraint source(*body, EnergyLimitSettings::PerElementEnergy(u_max), 5);
+  EnergyLimitSource source(*body, EnergyLimitSettings::PerElementEnergy(u_max), 5);
   std::vector<ConstraintRow> rows;
   const int appended = source.AppendRows(x, 3, rows);
   ASSERT_EQ(appended, static_cast<int>(rows.size()));
@@ -108,10 +108,10 @@ TEST(EnergyLimitConstraintTest, RowsAreEmittedExactlyBelowTheMargin) {
   EXPECT_EQ(source.CalcMaxViolation(body->model().rest_positions()), 0.0);
 }
 
-TEST(EnergyLimitConstraintTest, RowJacobianMatchesFiniteDifferencesOfTheBodyEnergyRatio) {
+TEST(EnergyLimitSourceTest, RowJacobianMatchesFiniteDifferencesOfTheBodyEnergyRatio) {
   auto body = MakeCube(2e3, 1);
   const VecX x = Stretched(*body, 0.1);
-  EnergyLimitConstraint source(*body, EnergyLimitSettings::PerElementEnergy(1e-9), 0);
+  EnergyLimitSource source(*body, EnergyLimitSettings::PerElementEnergy(1e-9), 0);
   std::vector<ConstraintRow> rows;
   source.AppendRows(x, 0, rows);
   ASSERT_EQ(rows.size(), 6u);
@@ -127,10 +127,10 @@ TEST(EnergyLimitConstraintTest, RowJacobianMatchesFiniteDifferencesOfTheBodyEner
   }
 }
 
-TEST(EnergyLimitConstraintTest, EnergyDensityIsMultipliedByTheRestVolume) {
+TEST(EnergyLimitSourceTest, EnergyDensityIsMultipliedByTheRestVolume) {
   auto body = MakeCube(2e3, 2);
   const double density = 3.0;  // J/m^3
-  EnergyLimitConstraint source(*body, EnergyLimitSettings::EnergyDensity(density), 0);
+  EnergyLimitSource source(*body, EnergyLimitSettings::EnergyDensity(density), 0);
   const TetElementModel& tets = Tets(*body);
   const double cell_tet_volume = std::pow(0.05, 3) / 6.0;  // Kuhn tets: 1/6 of a 5 cm cube
   for (int e = 0; e < tets.num_elements(); ++e) {
@@ -145,14 +145,14 @@ TEST(EnergyLimitConstraintTest, EnergyDensityIsMultipliedByTheRestVolume) {
   EXPECT_NEAR(rows[0].C, 1.0 - ElementEnergy(*body, x, e) / (density * cell_tet_volume), 1e-12);
 }
 
-TEST(EnergyLimitConstraintTest, PerElementLimitsAndUnlimitedElements) {
+TEST(EnergyLimitSourceTest, PerElementLimitsAndUnlimitedElements) {
   auto body = MakeCube(2e3, 1);
   const VecX x = Stretched(*body, 0.1);
   EnergyLimitSettings settings;
   settings.element_u_max.assign(6, kInf);
   settings.element_u_max[2] = 1e-9;
   settings.element_u_max[4] = 1e-9;
-  EnergyLimitConstraint source(*body, settings, 1);
+  EnergyLimitSource source(*body, settings, 1);
   std::vector<ConstraintRow> rows;
   ASSERT_EQ(source.AppendRows(x, 0, rows), 2);
   EXPECT_EQ(rows[0].key & 0xff, 2u);
@@ -173,9 +173,9 @@ void ExpectInputError(const std::function<void()>& f, const std::vector<std::str
   }
 }
 
-TEST(EnergyLimitConstraintTest, BadSettingsThrowNamingBodyElementAndRange) {
+TEST(EnergyLimitSourceTest, BadSettingsThrowNamingBodyElementAndRange) {
   auto body = MakeCube(2e3, 1);
-  auto make = [&](const EnergyLimitSettings& s) { EnergyLimitConstraint source(*body, s, 0); };
+  auto make = [&](const EnergyLimitSettings& s) { EnergyLimitSource source(*body, s, 0); };
   ExpectInputError([&] { make(EnergyLimitSettings()); },
                    {"body 'cube' energy limits", "u_max = 0", "(0, +inf]"});
   ExpectInputError([&] { make(EnergyLimitSettings::PerElementEnergy(-1.0)); },
@@ -193,7 +193,7 @@ TEST(EnergyLimitConstraintTest, BadSettingsThrowNamingBodyElementAndRange) {
   margin.activation_margin = -0.1;
   ExpectInputError([&] { make(margin); }, {"cube", "activation_margin = -0.1", "[0, +inf]"});
   ExpectInputError(
-      [&] { EnergyLimitConstraint(*body, EnergyLimitSettings::PerElementEnergy(1), 1 << 16); },
+      [&] { EnergyLimitSource(*body, EnergyLimitSettings::PerElementEnergy(1), 1 << 16); },
       {"source id"});
   EXPECT_NO_THROW(make(EnergyLimitSettings::PerElementEnergy(kInf)));
 }
@@ -208,7 +208,7 @@ double RunHangingCube(bool limited, double density_limit, double* max_ratio, int
   std::vector<int> bottom;
   for (int i = 0; i < body->num_nodes(); ++i)
     if (body->model().rest_positions()[3 * i + 2] < 1e-9) bottom.push_back(i);
-  EnergyLimitConstraint limit(*body, EnergyLimitSettings::EnergyDensity(density_limit), 0);
+  EnergyLimitSource limit(*body, EnergyLimitSettings::EnergyDensity(density_limit), 0);
   std::vector<ConstraintSource*> sources;
   if (limited) sources.push_back(&limit);
   SqpSolver solver;
@@ -230,7 +230,7 @@ double RunHangingCube(bool limited, double density_limit, double* max_ratio, int
   return 0.1 - z / static_cast<double>(bottom.size());
 }
 
-TEST(EnergyLimitConstraintTest, HangingCubeKeepsEveryElementBelowItsEnergyLimit) {
+TEST(EnergyLimitSourceTest, HangingCubeKeepsEveryElementBelowItsEnergyLimit) {
   const double density_limit = 20.0;  // J/m^3 (about 8 % uniaxial strain at E = 2 kPa)
   double free_ratio = 0.0, limited_ratio = 0.0;
   int free_rows = 0, limited_rows = 0;
@@ -251,12 +251,12 @@ const HexElementModel& Hexes(const DeformableBody& body) {
   return dynamic_cast<const HexElementModel&>(body.model());
 }
 
-TEST(EnergyLimitConstraintTest, HexBodyRowsHaveEightNodesAndTheFrozenRotationJacobian) {
+TEST(EnergyLimitSourceTest, HexBodyRowsHaveEightNodesAndTheFrozenRotationJacobian) {
   auto body = MakeHexCube(2e3, 2);
   const HexElementModel& hexes = Hexes(*body);
   const VecX x = Stretched(*body, 0.1);
   const double u_max = 1e-9;
-  EnergyLimitConstraint source(*body, EnergyLimitSettings::PerElementEnergy(u_max), 2);
+  EnergyLimitSource source(*body, EnergyLimitSettings::PerElementEnergy(u_max), 2);
   std::vector<ConstraintRow> rows;
   ASSERT_EQ(source.AppendRows(x, 1, rows), 8);
   double worst = 0.0;
@@ -289,11 +289,11 @@ TEST(EnergyLimitConstraintTest, HexBodyRowsHaveEightNodesAndTheFrozenRotationJac
   for (const ConstraintRow& row : rows) min_C = std::min(min_C, row.C);
   EXPECT_NEAR(source.CalcMaxEnergyRatio(x), 1.0 - min_C, 1e-9 * (1.0 - min_C));
   // Energy densities are multiplied by the hex rest volume (5 cm cubes).
-  EnergyLimitConstraint density(*body, EnergyLimitSettings::EnergyDensity(3.0), 0);
+  EnergyLimitSource density(*body, EnergyLimitSettings::EnergyDensity(3.0), 0);
   for (double limit : density.element_limits()) EXPECT_NEAR(limit, 3.0 * std::pow(0.05, 3), 1e-15);
 }
 
-TEST(EnergyLimitConstraintTest, HangingHexCubeKeepsEveryElementBelowItsEnergyLimit) {
+TEST(EnergyLimitSourceTest, HangingHexCubeKeepsEveryElementBelowItsEnergyLimit) {
   const double density_limit = 20.0;  // J/m^3
   double free_ratio = 0.0, limited_ratio = 0.0;
   int free_rows = 0, limited_rows = 0;

@@ -1,7 +1,7 @@
 // Strain- and energy-limit sources on whole bodies: the curvature pass (AddIslandCurvature)
 // against FD and the per-element kernels, and the row reductions of issue 11 item 4 (fewer rows,
 // same feasible set) on beams and a pulled cube.
-#include "constraints/strain_limit_constraint.h"
+#include "constraints/strain_limit_source.h"
 
 #include <gtest/gtest.h>
 
@@ -15,7 +15,7 @@
 #include <vector>
 
 #include "constraints/deformable_island_body.h"
-#include "constraints/energy_limit_constraint.h"
+#include "constraints/energy_limit_source.h"
 #include "constraints/strain_limit_curvature.h"
 #include "demos/scenes/bullet_world_holder.h"
 #include "plugin/box_tet_mesher.h"
@@ -101,9 +101,9 @@ double MinEigenvalueRatio(const MatX& H) {
 // Isotropic rows of a uniformly stretched, rotated box: only the s_1 rows are active, where
 // -d^2C = kappa d^2 s_1 is convex (nothing is clamped), so the assembled metric equals the FD
 // of -sum_c w_c J_c over every node position.
-TEST(StrainLimitConstraintTest, CurvatureMatchesFdOfWeightedJacobians) {
+TEST(StrainLimitSourceTest, CurvatureMatchesFdOfWeightedJacobians) {
   auto body = MakeTetBox(Vec3(0.1, 0.1, 0.1), 2, 2, 2);
-  StrainLimitConstraint source(*body, StrainLimitSettings::Isotropic(0.96, 1.04), kSource);
+  StrainLimitSource source(*body, StrainLimitSettings::Isotropic(0.96, 1.04), kSource);
   const Mat3 Q = Eigen::AngleAxisd(0.7, Vec3(1.0, -2.0, 0.5).normalized()).toRotationMatrix();
   const VecX x = RotatedStretch(*body, 1.06, Q);
   std::vector<ConstraintRow> rows;
@@ -144,11 +144,14 @@ TEST(StrainLimitConstraintTest, CurvatureMatchesFdOfWeightedJacobians) {
 // A generic state (bent, twisted beam with anisotropic hyperbolic limits): the body metric is
 // the sum of the per-row kernels scattered to the element nodes, rows of other sources and rows
 // with weight 0 are skipped, and the result is symmetric PSD.
-TEST(StrainLimitConstraintTest, CurvatureScattersRowKernelsAndSkipsOtherRows) {
+TEST(StrainLimitSourceTest, CurvatureScattersRowKernelsAndSkipsOtherRows) {
   auto body = MakeTetBox(Vec3(1.0, 0.2, 0.2), 10, 2, 2);
-  const StrainLimitSettings limits =
+  StrainLimitSettings limits =
       StrainLimitSettings::PerAxis(Vec3(0.9, 0.96, 0.98), Vec3(1.05, 1.04, 1.02));
-  StrainLimitConstraint source(*body, limits, kSource);
+  // The per-row kernels alone; the frame factor's element sums are tested in
+  // tests/strain_frame_curvature_test.cc.
+  limits.full_frame_curvature = false;
+  StrainLimitSource source(*body, limits, kSource);
   ASSERT_EQ(source.params().projection, StrainProjection::kHyperbolic);
   const VecX x = BentTwisted(*body, 2.0, 0.5);
   std::vector<ConstraintRow> rows;
@@ -184,7 +187,7 @@ TEST(StrainLimitConstraintTest, CurvatureScattersRowKernelsAndSkipsOtherRows) {
 }
 
 // Energy rows (tets and hexes): weights[c] R K_e R^T / U_max per row, R frozen at the iterate.
-TEST(StrainLimitConstraintTest, EnergyCurvatureIsWeightedFrozenStiffness) {
+TEST(StrainLimitSourceTest, EnergyCurvatureIsWeightedFrozenStiffness) {
   auto tet_body = MakeTetBox(Vec3(0.1, 0.1, 0.1), 2, 2, 2);
   DeformableBodySettings settings;
   settings.name = "hex box";
@@ -196,7 +199,7 @@ TEST(StrainLimitConstraintTest, EnergyCurvatureIsWeightedFrozenStiffness) {
     const Mat3 Q = Eigen::AngleAxisd(0.4, Vec3(0.3, 1.0, -0.2).normalized()).toRotationMatrix();
     VecX x = RotatedStretch(*body, 1.05, Q);
     for (Eigen::Index k = 0; k < x.size(); ++k) x[k] += 1e-3 * std::sin(3.0 * k);
-    EnergyLimitConstraint source(*body, EnergyLimitSettings::PerElementEnergy(1e-4), kSource);
+    EnergyLimitSource source(*body, EnergyLimitSettings::PerElementEnergy(1e-4), kSource);
     std::vector<ConstraintRow> rows;
     source.AppendRows(x, 0, rows);
     ASSERT_EQ(static_cast<int>(rows.size()), body->model().num_elements());
@@ -234,7 +237,7 @@ TEST(StrainLimitConstraintTest, EnergyCurvatureIsWeightedFrozenStiffness) {
 // receives the number of distinct constrained principal stretches (element, v_i, bound).
 int CountRows(const DeformableBody& body, const StrainLimitSettings& settings, const VecX& x,
               int* stretches = nullptr) {
-  StrainLimitConstraint source(body, settings, kSource);
+  StrainLimitSource source(body, settings, kSource);
   std::vector<ConstraintRow> rows;
   const int count = source.AppendRows(x, 0, rows);
   std::map<std::tuple<int, int, int>, int> distinct;
@@ -259,7 +262,7 @@ StrainLimitSettings Paper(StrainLimitSettings settings) {
 // isotropic limit constrains more stretches than the looser hyperbolic rule, so the row counts of
 // the two are compared on their own trajectories, not here). Unequal hyperbolic limits: the band
 // drops rows and keeps the violation.
-TEST(StrainLimitConstraintTest, FewerRowsOnABentBeam) {
+TEST(StrainLimitSourceTest, FewerRowsOnABentBeam) {
   auto body = MakeTetBox(Vec3(1.0, 0.2, 0.2), 10, 2, 2);
   const VecX x = BentTwisted(*body, 2.5, 0.4);
   int iso_paper_stretches = 0, iso_stretches = 0;
@@ -281,7 +284,7 @@ TEST(StrainLimitConstraintTest, FewerRowsOnABentBeam) {
   EXPECT_GE(iso_paper, iso_paper_stretches);
   EXPECT_GT(aniso_rows, 0);
   EXPECT_LT(aniso_rows, aniso_paper);
-  StrainLimitConstraint banded(*body, aniso, kSource), full(*body, Paper(aniso), kSource);
+  StrainLimitSource banded(*body, aniso, kSource), full(*body, Paper(aniso), kSource);
   EXPECT_GT(full.CalcMaxViolation(x), 0.0);
   EXPECT_EQ(banded.CalcMaxViolation(x), full.CalcMaxViolation(x));
   EXPECT_EQ(banded.CalcViolationSum(x), full.CalcViolationSum(x));
@@ -293,7 +296,7 @@ TEST(StrainLimitConstraintTest, FewerRowsOnABentBeam) {
 struct PulledCube {
   BulletWorldHolder holder;
   DeformableBody* body = nullptr;
-  StrainLimitConstraint* limits = nullptr;
+  StrainLimitSource* limits = nullptr;
   std::vector<int> bottom;
 
   explicit PulledCube(const StrainLimitSettings& settings) {
@@ -324,7 +327,7 @@ struct PulledCube {
   }
 };
 
-TEST(StrainLimitConstraintTest, HyperbolicBandGivesTheSameStateAsAllRows) {
+TEST(StrainLimitSourceTest, HyperbolicBandGivesTheSameStateAsAllRows) {
   const StrainLimitSettings aniso =
       StrainLimitSettings::PerAxis(Vec3(0.95, 0.96, 0.97), Vec3(1.05, 1.04, 1.03));
   PulledCube banded(aniso), full(Paper(aniso));

@@ -1,4 +1,4 @@
-#include "constraints/energy_limit_constraint.h"
+#include "constraints/energy_limit_source.h"
 
 #include <algorithm>
 #include <cmath>
@@ -14,8 +14,8 @@ std::vector<double> GatherRestVolumes(const ElementModel& model) {
 }
 }  // namespace
 
-EnergyLimitConstraint::EnergyLimitConstraint(const DeformableBody& body,
-                                             const EnergyLimitSettings& settings, int source_id)
+EnergyLimitSource::EnergyLimitSource(const DeformableBody& body,
+                                     const EnergyLimitSettings& settings, int source_id)
     : body_(body), settings_(settings), key_(kEnergyLimitRowKey, source_id) {
   TAUT_DEMAND(body.model().nodes_per_element() <= kMaxRowNodes, "body '", body.name(),
               "': energy limits need elements of at most ", kMaxRowNodes, " nodes, got ",
@@ -24,11 +24,11 @@ EnergyLimitConstraint::EnergyLimitConstraint(const DeformableBody& body,
   u_max_ = CalcElementEnergyLimits(settings_, GatherRestVolumes(body.model()));
 }
 
-double EnergyLimitConstraint::CalcElementEnergy(const VecX& x, int e) const {
+double EnergyLimitSource::CalcElementEnergy(const VecX& x, int e) const {
   return body_.model().CalcElementEnergy(e, x);
 }
 
-void EnergyLimitConstraint::FillRow(const VecX& x, int e, ConstraintRow& row) const {
+void EnergyLimitSource::FillRow(const VecX& x, int e, ConstraintRow& row) const {
   // R recomputed from x, then frozen for the Jacobian J = f_e / U_max (docs/math.md §4.5).
   const ElementModel& model = body_.model();
   ElementVectors forces;
@@ -40,8 +40,7 @@ void EnergyLimitConstraint::FillRow(const VecX& x, int e, ConstraintRow& row) co
   for (int n = 0; n < row.num_nodes; ++n) row.nodes[n] = nodes[n];
 }
 
-int EnergyLimitConstraint::AppendRows(const VecX& x, int body_index,
-                                      std::vector<ConstraintRow>& rows) {
+int EnergyLimitSource::AppendRows(const VecX& x, int body_index, std::vector<ConstraintRow>& rows) {
   const int before = static_cast<int>(rows.size());
   const double tau = settings_.activation_margin;
   for (int e = 0; e < body_.model().num_elements(); ++e) {
@@ -58,9 +57,9 @@ int EnergyLimitConstraint::AppendRows(const VecX& x, int body_index,
   return static_cast<int>(rows.size()) - before;
 }
 
-void EnergyLimitConstraint::AddIslandCurvature(const IslandIterate& iterate,
-                                               const ConstraintRow* rows, const double* weights,
-                                               int count, CurvatureSink& sink) const {
+void EnergyLimitSource::AddIslandCurvature(const IslandIterate& iterate, const ConstraintRow* rows,
+                                           const double* weights, int count,
+                                           CurvatureSink& sink) const {
   for (int c = 0; c < count; ++c) {
     const ConstraintRow& row = rows[c];
     if (!key_.Owns(row.key) || !(weights[c] > 0.0)) continue;
@@ -73,24 +72,24 @@ void EnergyLimitConstraint::AddIslandCurvature(const IslandIterate& iterate,
   }
 }
 
-double EnergyLimitConstraint::CalcElementRatio(const VecX& x, int e) const {
+double EnergyLimitSource::CalcElementRatio(const VecX& x, int e) const {
   if (std::isinf(u_max_[e])) return 0.0;
   return CalcElementEnergy(x, e) / u_max_[e];
 }
 
-double EnergyLimitConstraint::CalcMaxViolation(const VecX& x) const {
+double EnergyLimitSource::CalcMaxViolation(const VecX& x) const {
   // max(0, -C) = max(0, U/U_max - 1).
   return std::max(0.0, CalcMaxEnergyRatio(x) - 1.0);
 }
 
-double EnergyLimitConstraint::CalcViolationSum(const VecX& x) const {
+double EnergyLimitSource::CalcViolationSum(const VecX& x) const {
   double sum = 0.0;
   for (int e = 0; e < body_.model().num_elements(); ++e)
     sum += std::max(0.0, CalcElementRatio(x, e) - 1.0);
   return sum;
 }
 
-double EnergyLimitConstraint::CalcMaxEnergyRatio(const VecX& x) const {
+double EnergyLimitSource::CalcMaxEnergyRatio(const VecX& x) const {
   double ratio = 0.0;
   for (int e = 0; e < body_.model().num_elements(); ++e)
     ratio = std::max(ratio, CalcElementRatio(x, e));

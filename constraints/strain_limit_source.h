@@ -1,0 +1,70 @@
+// Strain limits of one tet body as a source of SQP rows (paper A; docs/math.md §2-§3).
+#pragma once
+
+#include <array>
+#include <cmath>
+
+#include "constraints/constraint_row.h"
+#include "constraints/row_key_layouts.h"
+#include "constraints/strain_limit_rows.h"
+#include "plugin/tet_element_model.h"
+
+namespace taut {
+
+// Emits the strain-limit rows of every tet of a body whose C is below the activation margin.
+class StrainLimitSource final : public BodyConstraintSource {
+ public:
+  // `body` must be a tet body; settings are validated (throws InputError naming the body).
+  // `source_id` (< 2^16, else InputError) makes row keys unique among the sources of a world.
+  StrainLimitSource(const DeformableBody& body, const StrainLimitSettings& settings, int source_id);
+
+  const DeformableBody& body() const override { return body_; }
+  int AppendRows(const VecX& x, int body_index, std::vector<ConstraintRow>& rows) override;
+  double CalcMaxViolation(const VecX& x) const override;
+  double CalcViolationSum(const VecX& x) const override;
+  // Adds weights[c] [-d^2 C_c/dx^2]_+ of the rows of this source (element and row decoded from
+  // the key) at the iterate: the s_i curvature of constraints/strain_limit_curvature.h.
+  void AddIslandCurvature(const IslandIterate& iterate, const ConstraintRow* rows,
+                          const double* weights, int count, CurvatureSink& sink) const override;
+
+  const StrainLimitSettings& settings() const { return settings_; }
+  // The compiled limits (params().projection is the evaluated rule).
+  const StrainLimitParams& params() const { return params_; }
+  // Strain |G q_j| - 1 along limit axis j of every element at x (for reports), largest value.
+  double CalcMaxAxisStrain(const VecX& x, int axis) const;
+
+ private:
+  // Largest violation of element e at x.
+  double CalcElementViolation(const VecX& x, int e) const;
+  // True when element e (positions xe) certainly has no active row: all its principal stretches
+  // (bounded by Gershgorin discs of F^T F) lie well inside the limits (hyperbolic and ellipsoid
+  // modes; the bound is in the constructor). Saves the SVD of untouched elements.
+  bool IsSurelyInactive(const std::array<Vec3, 4>& xe, int e) const;
+
+  // The SVD of element e at positions xe, kept for the curvature at the same positions.
+  const SignedSvd& RememberSvd(int e, const TetPositions& xe, const SignedSvd& svd);
+  // The kept SVD of element e when it was taken at xe, else a fresh one.
+  SignedSvd FindOrCalcSvd(int e, const TetPositions& xe) const;
+
+  // The SVD of each element at the positions of the last AppendRows.
+  struct CachedSvd {
+    TetPositions x;
+    SignedSvd svd;
+    bool valid = false;
+  };
+  std::vector<CachedSvd> svd_cache_;
+
+  const DeformableBody& body_;
+  const TetElementModel& tets_;
+  StrainLimitSettings settings_;
+  StrainLimitParams params_;
+  RowKeyPacker<4> key_;                              // kStrainLimitRowKey with this source's id
+  std::vector<StrainLimitRow> element_rows_;         // scratch, reused
+  bool screen_ = false;                              // IsSurelyInactive applies
+  double stretch_lo_ = 0.0, stretch_hi_ = HUGE_VAL;  // stretches that certainly emit no row
+};
+
+// The name of earlier releases, kept so that code written against them still compiles.
+using StrainLimitConstraint [[deprecated("renamed StrainLimitSource")]] = StrainLimitSource;
+
+}  // namespace taut
