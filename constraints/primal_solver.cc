@@ -572,8 +572,8 @@ bool PrimalSolver::IsNewtonIterateCertified(const std::vector<IslandBody*>& bodi
   // stopped at the tolerance crept 15 mm in 2 s where the exact solve holds it.
   CalcProjectedMultipliers();
   const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
-  const KktResiduals kkt =
-      CalcKktResiduals(bodies, rows_, lambda_, v_, h, distance_scale, scratch_);
+  newton_kkt_ = CalcKktResiduals(bodies, rows_, lambda_, v_, h, distance_scale, scratch_);
+  const KktResiduals& kkt = newton_kkt_;
   if (!IsCertified(kkt, settings.violation_tolerance, settings.stationarity_tolerance))
     return false;
   const double distance_tolerance =
@@ -643,6 +643,7 @@ void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
   }
   iterate_ = settings.warm_start ? warm : KeyedMultipliers();
   rho_kept_ = false;
+  newton_certified_ = false;
   last_violation_.clear();
   kept_growth_.clear();
   refactor_next_ = false;  // a factor kept from the previous step may precondition this one
@@ -655,8 +656,12 @@ void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     rows_.CountTypes(stats);
     const auto t = std::chrono::steady_clock::now();
     const double ms_rows_before = stats.ms_rows;  // row collection inside is ms_rows, not ms_solve
-    const KktResiduals kkt =
-        CalcKktResiduals(bodies, rows_, lambda_bar_, v_, h, distance_scale, scratch_);
+    // After a Newton stop on the certificate, lambda_bar = Proj(y(v)) at the same rows: its
+    // residuals are the ones just computed.
+    const KktResiduals kkt = newton_certified_ ? newton_kkt_
+                                               : CalcKktResiduals(bodies, rows_, lambda_bar_, v_, h,
+                                                                  distance_scale, scratch_);
+    newton_certified_ = false;
     RecordKkt(kkt, stats);
     stats.converged =
         IsCertified(kkt, settings.violation_tolerance, settings.stationarity_tolerance);
@@ -670,9 +675,11 @@ void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     KeepPenalties();
     for (int it = 0; it < primal.max_newton_iterations; ++it) {
       if (!TakeNewtonStep(h, bodies, sources, settings, stats)) break;
-      if (primal.stop_newton_on_certificate && IsNewtonIterateCertified(bodies, h, settings)) break;
+      newton_certified_ =
+          primal.stop_newton_on_certificate && IsNewtonIterateCertified(bodies, h, settings);
+      if (newton_certified_) break;
     }
-    CalcProjectedMultipliers();
+    if (!newton_certified_) CalcProjectedMultipliers();  // else lambda_ is Proj(y(v)) already
     lambda_bar_ = lambda_;
     rows_.Store(lambda_bar_, iterate_);
     stats.sqp_iterations = k + 1;

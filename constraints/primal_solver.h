@@ -128,6 +128,8 @@ class PrimalSolver {
   double stale_budget_ = 0.0;              // CG iterations a kept factor may take before a refactor
   bool refactor_next_ = false;             // the last kept factor took too many: refactor
   double violation_ = 0.0;                 // largest row violation at the collected rows
+  bool newton_certified_ = false;          // the Newton loop stopped on the certificate ...
+  KktResiduals newton_kkt_;                // ... with these residuals at (v, Proj(y(v)))
   double line_a0_ = 0.0, line_dAd_ = 0.0;  // d^T A (v - v*) and d^T A d of the model line search
   CurvatureMetric curvature_;
   VecX curvature_weights_;  // h lambda_c of the rows, for the sources' curvature
