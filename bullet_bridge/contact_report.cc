@@ -151,8 +151,9 @@ void AppendLimit(const std::vector<IslandBody*>& bodies, const ConstraintRow& ro
   if (row.type == RowType::kStrainLimit) {
     const StrainLimitKey key = StrainLimitKey::Unpack(RowKeyPayload(row.key));
     limit.element = key.element;
-    limit.kind =
-        key.bound == StrainBound::kMin ? LimitRowKind::kStrainMin : LimitRowKind::kStrainMax;
+    limit.kind = key.axis == kStrainFloorAxis     ? LimitRowKind::kStrainFloor
+                 : key.bound == StrainBound::kMin ? LimitRowKind::kStrainMin
+                                                  : LimitRowKind::kStrainMax;
     limit.axis = key.axis;
     limit.principal_axis = key.principal_axis;
   } else {

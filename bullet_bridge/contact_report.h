@@ -69,9 +69,10 @@ struct RigidBodyWrench {
 
 // What a limit row bounds.
 enum class LimitRowKind : std::uint8_t {
-  kStrainMin,  // a principal stretch's lower limit (StrainLimitSource)
-  kStrainMax,  // a principal stretch's upper limit
-  kEnergy,     // the element's elastic energy U_e <= U_max (EnergyLimitSource)
+  kStrainMin,    // a principal stretch's lower limit (StrainLimitSource)
+  kStrainMax,    // a principal stretch's upper limit
+  kEnergy,       // the element's elastic energy U_e <= U_max (EnergyLimitSource)
+  kStrainFloor,  // a principal stretch's non-inversion floor (StrainLimitSettings::inversion_floor)
 };
 
 // One strain- or energy-limit row the solve held (every row collected at its final velocities:
@@ -81,7 +82,7 @@ struct LimitRowMultiplier {
   const DeformableBody* body = nullptr;
   int element = -1;
   LimitRowKind kind = LimitRowKind::kStrainMax;
-  int axis = -1;            // strain rows: limit axis j (0-2), else -1 (kStrainLimitRowKey)
+  int axis = -1;  // strain rows: limit axis j (0-2), else -1 (kStrainLimitRowKey; floor rows: 3)
   int principal_axis = -1;  // strain rows: matched material axis m = pi(i) (0-2), else -1
   double C = 0.0;           // row value at the end of the substep: 0 at the limit, < 0 violated [-]
   // lambda >= 0: J [1/m] maps it to nodal impulses J_n lambda [N s], so its unit is N m s.

@@ -17,7 +17,8 @@ class IslandSolver {
   // n; the primal's cost is one sparse factorization per Newton iteration.
   static constexpr double kPrimalRowsPerDof = 0.3;
 
-  // Solves the island's step; the path taken is counted in stats.islands_dual / islands_primal.
+  // Solves the island's step into `stats` (fresh for each island: a retried island's are replaced
+  // by the kept solve's); the path kept is counted in stats.islands_dual / islands_primal.
   void Solve(double h, const std::vector<IslandBody*>& bodies,
              const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
              StepStats& stats);
@@ -55,6 +56,19 @@ class IslandSolver {
   }
 
  private:
+  // The path of this step: settings.solver, or for kAuto the rule of ChooseAuto.
+  IslandSolverKind ChoosePath(const std::vector<IslandBody*>& bodies,
+                              const SqpSettings& settings) const;
+  // The dual path, with the failure rule of kAuto (primal_steps_left_).
+  void SolveDual(double h, const std::vector<IslandBody*>& bodies,
+                 const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
+                 StepStats& stats);
+  // After a failed dual step (kAuto, retry_failed_dual_on_primal): the primal path from the
+  // step's start velocities `start` and warm starts `warm_start`; keeps the better answer.
+  void RetryOnPrimal(double h, const std::vector<IslandBody*>& bodies,
+                     const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
+                     const KeyedMultipliers& warm_start, StepStats& stats);
+
   SqpSolver dual_;
   PrimalSolver primal_;
   KeyedMultipliers warm_;      // last step's multipliers by key, whichever path ran
@@ -62,6 +76,7 @@ class IslandSolver {
   int primal_steps_left_ = 0;  // > 0: the dual path failed recently, stay primal
   int primal_window_ = kPrimalStepsAfterDualFailure;  // primal steps after the next failure
   bool solved_primal_ = false;                        // the last Solve took the primal path
+  std::vector<VecX> start_v_, dual_v_;  // retry: velocities at the start and of the dual answer
 };
 
 }  // namespace taut

@@ -628,6 +628,19 @@ void PrimalSolver::ChooseStartVelocities(double h, const std::vector<IslandBody*
   if (moved) try_candidate();
 }
 
+bool PrimalSolver::MoveToUnconstrainedVelocity(double h, const std::vector<IslandBody*>& bodies,
+                                               const std::vector<ConstraintSource*>& sources,
+                                               const SqpSettings& settings, StepStats& stats) {
+  bool at_v_star = true;
+  for (size_t b = 0; b < bodies.size(); ++b) {
+    v_trial_[b] = bodies[b]->v_star();
+    at_v_star = at_v_star && v_[b] == v_trial_[b];
+  }
+  if (at_v_star) return false;
+  CollectRowsAt(h, bodies, sources, v_trial_, settings, stats);
+  return !rows_.empty();
+}
+
 void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
                          const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
                          KeyedMultipliers& warm, StepStats& stats) {
@@ -651,7 +664,8 @@ void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
   CollectRowsAt(h, bodies, sources, start, settings, stats);
   stats.violation_before = violation_;
   ChooseStartVelocities(h, bodies, sources, settings, stats);
-  for (int k = 0; !rows_.empty(); ++k) {
+  for (int k = 0;; ++k) {
+    if (rows_.empty() && !MoveToUnconstrainedVelocity(h, bodies, sources, settings, stats)) break;
     // Certificate of (v, lambda_bar) at the rows of v.
     rows_.CountTypes(stats);
     const auto t = std::chrono::steady_clock::now();

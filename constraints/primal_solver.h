@@ -51,6 +51,12 @@ class PrimalSolver {
   void CollectRowsAt(double h, const std::vector<IslandBody*>& bodies,
                      const std::vector<ConstraintSource*>& sources, const std::vector<VecX>& v,
                      const SqpSettings& settings, StepStats& stats);
+  // Stage, at an iterate without rows: the minimizer there is v* (H = A), so the iterate moves
+  // to v* and collects its rows (a start candidate or a Newton step inside every margin would
+  // otherwise end the step away from v*). False when already at v* or v* has no rows: done.
+  bool MoveToUnconstrainedVelocity(double h, const std::vector<IslandBody*>& bodies,
+                                   const std::vector<ConstraintSource*>& sources,
+                                   const SqpSettings& settings, StepStats& stats);
   // Stage: the start of the Newton iterations, the candidate velocity of least Phi (v*, the warm
   // start below, the step-start velocity); leaves its rows collected.
   void ChooseStartVelocities(double h, const std::vector<IslandBody*>& bodies,

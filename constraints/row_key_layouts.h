@@ -13,7 +13,7 @@ inline constexpr RowKeyLayout<4> kStrainLimitRowKey{
     "strain limits",
     {{
         {"element", 31},        // element index (any int >= 0)
-        {"axis", 2},            // limit axis j, 0-2
+        {"axis", 2},            // limit axis j, 0-2; 3 = non-inversion floor (kStrainFloorAxis)
         {"principal axis", 2},  // matched material axis m = pi(i), 0-2
         {"bound", 1},           // StrainBound: 0 min, 1 max
     }}};

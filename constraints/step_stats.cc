@@ -46,6 +46,7 @@ void AddWork(const StepStats& part, StepStats& total) {
   total.newton_iterations += part.newton_iterations;
   total.pcg_iterations += part.pcg_iterations;
   total.newton_factorizations += part.newton_factorizations;
+  total.islands_retried += part.islands_retried;
 }
 
 // worst = max(worst, part) for every violation and residual [C units or relative, as in
@@ -91,6 +92,18 @@ void AddIslandStats(const StepStats& island, StepStats& step) {
   AddWork(island, step);
   step.sqp_iterations = std::max(step.sqp_iterations, island.sqp_iterations);
   KeepWorst(island, step);
+}
+
+void AddDroppedSolveWork(const StepStats& dropped, StepStats& kept) {
+  kept.ms_rows += dropped.ms_rows;
+  kept.ms_solve += dropped.ms_solve;
+  kept.pgs_sweeps += dropped.pgs_sweeps;
+  kept.sqp_iterations += dropped.sqp_iterations;
+  kept.restoration_iterations += dropped.restoration_iterations;
+  kept.active_set_solves += dropped.active_set_solves;
+  kept.newton_iterations += dropped.newton_iterations;
+  kept.pcg_iterations += dropped.pcg_iterations;
+  kept.newton_factorizations += dropped.newton_factorizations;
 }
 
 void AddSubstepStats(const StepStats& substep, StepStats& call) {

@@ -57,6 +57,10 @@ struct StepStats {
   int pcg_iterations = 0;         // primal path: PCG iterations (1 per Newton step when local)
   int newton_factorizations = 0;  // primal path: Newton matrices factored (fewer than Newton
                                   // iterations when bodies keep their factor, PrimalSettings)
+  // Islands whose dual step failed its certificate and was solved again on the primal path
+  // (SqpSettings::retry_failed_dual_on_primal); islands_dual / islands_primal count the path
+  // whose answer was kept, the work counts and times include both solves.
+  int islands_retried = 0;
   // Convergence certificate at the end of the step (constraints/kkt_certificate.h), worst island:
   double kkt_primal = 0.0;           // max(0, -C) of every row (distance rows scaled), C units
   double kkt_complementarity = 0.0;  // |C| of pushing rows, slip of sticking contacts, C units
@@ -84,6 +88,11 @@ struct StepStats {
 // solves), violations and residuals the worst island's, converged only when every island
 // converged. The stage times, islands and rigid_bodies_coupled are the world's own.
 void AddIslandStats(const StepStats& island, StepStats& step);
+
+// Adds the work of a solve whose answer was dropped (a retried island, islands_retried) to the
+// statistics of the one kept: row and solve times [ms], SQP, PGS, Newton and PCG counts summed
+// (the solves ran one after the other); rows, paths, violations and residuals stay the kept's.
+void AddDroppedSolveWork(const StepStats& dropped, StepStats& kept);
 
 // Adds one substep's statistics to the totals of a whole stepSimulation call `call`: every time
 // [ms] and every count (rows, iterations, islands, coupled rigid bodies, substeps) summed, so a

@@ -155,6 +155,11 @@ Mat9 CalcPrincipalStrainRowCurvature(const SignedSvd& svd, const Mat3& Q,
   const Mat3 V_prime = Q.transpose() * svd.V;
   // The key names v_i by its matched material axis (R3), so find i at this SVD.
   const int i = FindMatchedPrincipalIndex(CalcPrincipalAxisMatch(V_prime), key.principal_axis);
+  // Floor rows have no frame factor: -d^2 C = -d^2 s_i / (1 - s_floor) (docs/math.md §3.8).
+  if (key.axis == kStrainFloorAxis) {
+    return (-1.0 / (1.0 - params.inversion_floor)) *
+           CalcStretchHessian(svd.s, i, params.svd_gap_epsilon);
+  }
   const bool is_max = key.bound == StrainBound::kMax;
   const double sigma = is_max ? 1.0 : -1.0;
   // M = Q diag(k^2) Q^T: k = kappa (ellipsoid) or kappa_j e_j (hyperbolic row (j, i)).

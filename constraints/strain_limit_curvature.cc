@@ -6,6 +6,8 @@ namespace taut {
 
 double CalcStrainRowStretchSlope(const Mat3& V_prime, int i, const StrainLimitParams& params,
                                  const StrainLimitKey& key) {
+  // Floor: C = (s_i - s_floor) / (1 - s_floor) (docs/math.md §3.8).
+  if (key.axis == kStrainFloorAxis) return 1.0 / (1.0 - params.inversion_floor);
   const bool is_max = key.bound == StrainBound::kMax;
   const Vec3 w = V_prime.col(i);
   switch (params.projection) {

@@ -41,6 +41,7 @@ class RowEvaluator {
       // R2: C_max only where s_i > 1, C_min only where s_i < 1.
       if (e > 0.0 && params_.has_max) EvaluatePrincipal(i, StrainBound::kMax);
       if (e < 0.0 && params_.has_min) EvaluatePrincipal(i, StrainBound::kMin);
+      if (params_.inversion_floor > 0.0) EvaluateFloor(i);
     }
     return min_C_;
   }
@@ -156,6 +157,15 @@ class RowEvaluator {
     Vec12 J = -sigma * n * ds_;
     if (!SkipFrameTerm(kappa)) J -= (sigma * e / n) * (dw_.transpose() * kappa.cwiseProduct(kw));
     Emit(i, -1, bound, C, J);
+  }
+
+  // Non-inversion floor (docs/math.md §3.8): C = (s_i - f) / (1 - f), dC = ds_i / (1 - f).
+  void EvaluateFloor(int i) {
+    const double scale = 1.0 / (1.0 - params_.inversion_floor);
+    const double C = (svd_.s[i] - params_.inversion_floor) * scale;
+    if (!Accept(C)) return;
+    CalcGradients(i);
+    Emit(i, kStrainFloorAxis, StrainBound::kMin, C, scale * ds_);
   }
 
   // Tracks min C; true when the row is to be emitted with a Jacobian.

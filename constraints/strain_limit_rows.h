@@ -9,6 +9,7 @@
 //   linear interp (i): C = 1 - |s_i - 1| / |L - 1|,  L = ||diag(s^j) V' e_i||  (eqs. 21-22)
 //   orthogonal (j,i):  C = |V'_ji| - |s_i - 1| / |d^j|   (eqs. 19-20 divided by |d^j|; here
 //                      d_eff = d^j |V'_ji| vanishes on orthogonal pairs, so it cannot divide)
+//   floor (i):         C = (s_i - s_floor) / (1 - s_floor)   (non-inversion, docs/math.md §3.8)
 // with kappa^j, d^j from the bound's side (max: s_i > 1, min: s_i < 1). OP and LI use the capped
 // deviations of StrainLimitParams. Only rows with C < tau are emitted, C_max only where s_i > 1
 // and C_min only where s_i < 1 (docs/math.md §2 R2); the others hold with margin. sgn(0) := 0 at
@@ -28,13 +29,18 @@ namespace taut {
 
 enum class StrainBound : std::uint8_t { kMin = 0, kMax = 1 };
 
+// StrainLimitKey::axis of a non-inversion floor row (StrainLimitSettings::inversion_floor):
+// C = (s_i - s_floor) / (1 - s_floor) on every principal stretch, bound kMin, any frame.
+inline constexpr std::int8_t kStrainFloorAxis = 3;
+
 // Identity of a strain-limit row for warm starts, stable when singular values swap order
 // (docs/math.md §2 R3): it never uses the principal index i. Instead principal direction v_i is
 // named by the material axis it is matched to, m = pi(i), where pi is the permutation maximising
 // sum_i |V'_{pi(i) i}| (each principal direction to its nearest limit axis, one to one).
 struct StrainLimitKey {
   int element = -1;
-  std::int8_t axis = -1;  // limit axis j (hyperbolic, OP); = principal_axis (LI, ellipsoid)
+  // limit axis j (hyperbolic, OP); = principal_axis (LI, ellipsoid); kStrainFloorAxis (floor)
+  std::int8_t axis = -1;
   std::int8_t principal_axis = -1;  // m = pi(i), the matched material axis of v_i
   StrainBound bound = StrainBound::kMax;
 

@@ -26,12 +26,17 @@ StrainLimitSource::StrainLimitSource(const DeformableBody& body,
   // Hyperbolic and ellipsoid rows of principal axis i have C = 1 - kappa_eff (s_i - 1) with
   // kappa_eff <= max_j kappa^j (|V'_ji| <= 1; ||K w|| <= max kappa), so no row of an element is
   // active (C < tau) while every stretch lies in [1 - (1-tau)/max kappa_min,
-  // 1 + (1-tau)/max kappa_max].
+  // 1 + (1-tau)/max kappa_max], and above the floor's activation (below).
   screen_ = params_.projection == StrainProjection::kHyperbolic ||
             params_.projection == StrainProjection::kEllipsoid;
   const double slack = 1.0 - params_.activation_margin;
   stretch_hi_ = params_.has_max ? 1.0 + slack / params_.kappa_max.maxCoeff() : HUGE_VAL;
   stretch_lo_ = params_.has_min ? 1.0 - slack / params_.kappa_min.maxCoeff() : 0.0;
+  // Floor rows C = (s_i - f) / (1 - f) are active below s_i = f + tau (1 - f) (docs/math.md §3.8).
+  if (params_.inversion_floor > 0.0) {
+    const double f = params_.inversion_floor;
+    stretch_lo_ = std::max(stretch_lo_, f + params_.activation_margin * (1.0 - f));
+  }
   screen_ = screen_ && std::isfinite(slack) && slack > 0.0;
 }
 

@@ -108,6 +108,8 @@ void StrainLimitSettings::Validate(int num_elements, const std::string& where) c
               ": svd_gap_epsilon = ", svd_gap_epsilon, " is out of range; valid: finite and >= 0");
   TAUT_DEMAND(hyperbolic_row_band >= 0.0, where, ": hyperbolic_row_band = ", hyperbolic_row_band,
               " is out of range; valid: [0, +inf]");
+  TAUT_DEMAND(inversion_floor >= 0.0 && inversion_floor < 1.0, where,
+              ": inversion_floor = ", inversion_floor, " is out of range; valid: [0, 1)");
 }
 
 StrainLimitParams CalcStrainLimitParams(const StrainLimitSettings& settings) {
@@ -128,6 +130,8 @@ StrainLimitParams CalcStrainLimitParams(const StrainLimitSettings& settings) {
   params.freeze_frame_jacobian = settings.freeze_frame_jacobian;
   params.full_frame_curvature = settings.full_frame_curvature;
   params.hyperbolic_row_band = settings.hyperbolic_row_band;
+  // The floor guards limited elements only: a body without limits emits no rows at all.
+  params.inversion_floor = params.has_min || params.has_max ? settings.inversion_floor : 0.0;
   params.projection = SelectEvaluatedProjection(settings, params);
   return params;
 }

@@ -34,6 +34,8 @@ constexpr double kUnlimitedStretch = std::numeric_limits<double>::infinity();
 constexpr double kDefaultStrainActivationMargin = 0.2;
 // Default band of the hyperbolic row filter (StrainLimitSettings::hyperbolic_row_band) [C units].
 constexpr double kDefaultHyperbolicRowBand = 0.05;
+// Default non-inversion floor (StrainLimitSettings::inversion_floor) [-].
+constexpr double kDefaultInversionFloor = 0.1;
 
 // Strain limits of one body. Build with Isotropic() or PerAxis(), then Validate().
 struct StrainLimitSettings {
@@ -56,6 +58,15 @@ struct StrainLimitSettings {
   // C_j >= C_min at the iterate, so the feasible set is unchanged (violations are always
   // measured over every row); +inf emits every row (paper A). Default 0.05.
   double hyperbolic_row_band = kDefaultHyperbolicRowBand;
+  // Non-inversion floor s_floor in [0, 1) [-]: every principal stretch of a limited element stays
+  // at or above it, s_i >= s_floor for i = 1..3, whatever the axis limits (docs/math.md §3.8).
+  // Axis limits leave the unlimited directions free, and there a soft element can be crushed
+  // through s_3 = 0 (inverted); at an inverted element the linearized axis rows can be locally
+  // infeasible (a stationary point with the row still violated). Rows
+  // C = (s_i - s_floor) / (1 - s_floor) >= 0, emitted within the activation margin like the
+  // others. Where an axis' own compress limit is below the floor, the floor wins. 0 = no floor.
+  // Default 0.1: no row appears until a principal stretch falls below 0.28.
+  double inversion_floor = kDefaultInversionFloor;
   // Body limit frame Q: columns are the limit axes in rest coordinates; a rotation. Default I.
   Mat3 frame = Mat3::Identity();
   // Optional per-element frames (fibre directions), one rotation per tet; when non-empty they
@@ -114,6 +125,7 @@ struct StrainLimitParams {
   bool freeze_frame_jacobian = false;                         // dV/dx := 0
   bool full_frame_curvature = false;                          // docs/math.md §5.9
   double hyperbolic_row_band = kDefaultHyperbolicRowBand;     // emit C_j <= C_min + band
+  double inversion_floor = kDefaultInversionFloor;            // s_i >= s_floor; 0 = none
 };
 
 // Converts validated settings into kappa and capped deviations (docs/math.md §3), and picks the

@@ -71,6 +71,27 @@ TEST(PrimalSolverTest, SameFirstConstrainedStepAsTheDualPath) {
       << "dual converged: " << ds.converged;
 }
 
+// From rest under a sudden pull the step-start velocity (0) has no rows while v* violates the
+// limits: a start without rows must still end at the constrained answer, not at the start (the
+// iterate moves to v* and collects its rows, PrimalSolver::MoveToUnconstrainedVelocity).
+TEST(PrimalSolverTest, StartWithoutRowsStillReachesTheConstrainedAnswer) {
+  SaggingBar primal(IslandSolverKind::kPrimal, 0.99, 1.01);
+  for (int i = 0; i < primal.body->num_nodes(); ++i)
+    if (primal.body->model().rest_positions()[3 * i] > 0.4 - 1e-9)
+      primal.body->AddNodeForce(i, Vec3(2000.0, 0.0, 0.0));  // ~5 % stretch in one step
+  primal.Run(1);
+  const StepStats& ps = primal.holder.world.last_step_stats();
+  EXPECT_GT(ps.violation_before, 1.0);  // v* is well past the limits
+  EXPECT_GT(ps.rows_strain, 0);
+  EXPECT_GT(ps.newton_iterations, 0);
+  // Certified (stationary with the limit forces, feasible, complementary): the constrained
+  // answer, which moves the bar out to its limit (at the start velocity 0 it would not move).
+  EXPECT_TRUE(ps.converged);
+  EXPECT_LE(primal.limit->CalcMaxViolation(primal.body->x()), 1e-3);
+  EXPECT_GT(primal.body->v().cwiseAbs().maxCoeff(), 0.1);
+  EXPECT_GT(primal.limit->CalcMaxAxisStrain(primal.body->x(), 0), 0.009);  // x at its 1 % limit
+}
+
 TEST(PrimalSolverTest, TightLimitsHoldEveryStepWithACertificate) {
   // +-1 % on a 5 kPa bar (unlimited it sags tens of percent): every step converged, every
   // element's principal stretches inside the limits to the tolerance.

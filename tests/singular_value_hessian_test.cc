@@ -110,8 +110,9 @@ TEST(SingularValueHessianTest, EigenvaluesAreTheInverseGaps) {
                   1e-12);
 }
 
-// Isotropic ellipsoid rows C = 1 -+ kappa (s_i - 1) have no frame term, so -d^2C/dx^2 is exactly
-// +-kappa d^2 s_i/dx^2: the node-space assembly against central differences of the row's J.
+// Isotropic ellipsoid rows C = 1 -+ kappa (s_i - 1) and the floor rows C = (s_i - s_floor) /
+// (1 - s_floor) have no frame term, so -d^2C/dx^2 is exactly -+ dC/ds_i d^2 s_i/dx^2: the
+// node-space assembly against central differences of the row's J.
 TEST(SingularValueHessianTest, NodeAssemblyMatchesFdOfTheRowJacobian) {
   std::mt19937 rng(3);
   StrainLimitSettings settings = StrainLimitSettings::Isotropic(0.9, 1.1);
@@ -150,7 +151,10 @@ TEST(SingularValueHessianTest, NodeAssemblyMatchesFdOfTheRowJacobian) {
         };
         H_fd.col(c) = -(find(rp) - find(rm)) / (2.0 * h);
       }
-      const double kappa = 10.0;
+      // -dC/ds_i: kappa = 10 on the limit rows, 1 / (1 - s_floor) on the floor rows (C increases
+      // with s_i on the lower bound and the floor, decreases on the upper bound).
+      const double kappa =
+          row.key.axis == kStrainFloorAxis ? 1.0 / (1.0 - params.inversion_floor) : 10.0;
       const double scale = row.key.bound == StrainBound::kMax ? kappa : -kappa;
       const int i = row.principal_index;
       const Mat12 H = CalcTetSingularValueHessian(CalcSingularValueHessian(svd, i, 0.0), r, scale,

@@ -183,7 +183,10 @@ TEST(StrainFrameCurvatureIsotropicTest, ReducesToTheStretchCurvature) {
     const SignedSvd svd = CalcSignedSvd(CalcTetDeformationGradient(state.r, state.x));
     for (const StrainLimitRow& row : state.rows) {
       const bool is_max = row.key.bound == StrainBound::kMax;
-      const double scale = is_max ? 4.0 : -2.0;  // sigma kappa
+      // sigma kappa; the floor rows: -1 / (1 - s_floor) (docs/math.md §3.8).
+      const double scale = row.key.axis == kStrainFloorAxis ? -1.0 / (1.0 - params.inversion_floor)
+                           : is_max                         ? 4.0
+                                                            : -2.0;
       const Mat12 expected = CalcTetSingularValueHessian(
           CalcSingularValueHessian(svd, row.principal_index, params.svd_gap_epsilon), state.r,
           scale, /*clamp_negative=*/false);

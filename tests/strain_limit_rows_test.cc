@@ -22,11 +22,19 @@ constexpr StrainProjection kAllModes[] = {
     StrainProjection::kHyperbolic, StrainProjection::kOrthogonal,
     StrainProjection::kLinearInterpolation, StrainProjection::kEllipsoid};
 
-// Paper A's rows as printed: no switch to the ellipsoid rows for equal limits and no hyperbolic
-// row filter (the tests of the paper's rules and Jacobians use every row).
+// Paper A's rows as printed: no switch to the ellipsoid rows for equal limits, no hyperbolic
+// row filter and no non-inversion floor (the tests of the paper's rules and Jacobians use every
+// row).
 StrainLimitSettings Paper(StrainLimitSettings settings) {
   settings.equal_limits_use_ellipsoid = false;
   settings.hyperbolic_row_band = kInf;
+  settings.inversion_floor = 0.0;
+  return settings;
+}
+
+// The settings without the non-inversion floor (tests of the axis rules alone).
+StrainLimitSettings NoFloor(StrainLimitSettings settings) {
+  settings.inversion_floor = 0.0;
   return settings;
 }
 
@@ -272,7 +280,7 @@ TEST(StrainLimitRowsTest, KinkAtZeroFrameEntryIsFinite) {
   const Tet tet = TetFromG(Vec3(1.1, 1.02, 0.97).asDiagonal());
   for (const StrainProjection mode : kAllModes) {
     const StrainLimitParams params = CalcStrainLimitParams(
-        StrainLimitSettings::PerAxis(Vec3(0.9, 0.0, 0.9), Vec3(1.05, kInf, 1.2), mode));
+        NoFloor(StrainLimitSettings::PerAxis(Vec3(0.9, 0.0, 0.9), Vec3(1.05, kInf, 1.2), mode)));
     const std::vector<StrainLimitRow> rows = AllRows(tet.r, tet.x, Mat3::Identity(), params);
     ASSERT_FALSE(rows.empty());
     for (const StrainLimitRow& row : rows) {
@@ -561,7 +569,7 @@ TEST(StrainLimitRowsTest, IsotropicMeansEveryPrincipalStretchWithinTheLimits) {
   int feasible = 0, infeasible = 0;
   for (const StrainProjection requested :
        {StrainProjection::kEllipsoid, StrainProjection::kHyperbolic}) {
-    StrainLimitSettings settings = StrainLimitSettings::Isotropic(lo, hi);
+    StrainLimitSettings settings = NoFloor(StrainLimitSettings::Isotropic(lo, hi));
     settings.projection = requested;  // hyperbolic with equal limits: the same rows
     const StrainLimitParams params = CalcStrainLimitParams(settings);
     EXPECT_EQ(params.projection, StrainProjection::kEllipsoid);
@@ -625,7 +633,7 @@ TEST(StrainLimitRowsTest, HyperbolicBandKeepsTheFeasibleSetWithFewerRows) {
   for (int trial = 0; trial < 2000; ++trial) {
     const Vec3 s_min(0.9, 0.85, 0.95), s_max(1.1, 1.12, 1.05);
     StrainLimitSettings full = Paper(StrainLimitSettings::PerAxis(s_min, s_max));
-    StrainLimitSettings banded = StrainLimitSettings::PerAxis(s_min, s_max);
+    StrainLimitSettings banded = NoFloor(StrainLimitSettings::PerAxis(s_min, s_max));
     const StrainLimitParams p_full = CalcStrainLimitParams(full);
     const StrainLimitParams p_band = CalcStrainLimitParams(banded);
     ASSERT_EQ(p_band.projection, StrainProjection::kHyperbolic);
@@ -669,10 +677,82 @@ TEST(StrainLimitRowsTest, HyperbolicBandKeepsTheFeasibleSetWithFewerRows) {
   EXPECT_LT(kept_active, full_active);
 }
 
+// docs/math.md §3.8: with limits on x only, the floor rows C = (s_i - s_floor) / (1 - s_floor)
+// appear exactly for the principal stretches below s_floor + tau (1 - s_floor), whatever their
+// direction, with C read off independently computed stretches and J matching central
+// differences; an inverted element (s_3 < 0) violates its floor.
+TEST(StrainLimitRowsTest, InversionFloorRowsBoundEveryPrincipalStretch) {
+  std::mt19937 rng(90);
+  std::uniform_real_distribution<double> u(-0.6, 1.2);
+  StrainLimitSettings settings =
+      StrainLimitSettings::PerAxis(Vec3(0.95, 0.0, 0.0), Vec3(1.05, kInf, kInf));
+  settings.svd_gap_epsilon = 0.0;  // exact derivatives for the FD comparison
+  settings.Validate(1, "test");
+  const StrainLimitParams params = CalcStrainLimitParams(settings);
+  const double f = params.inversion_floor;
+  ASSERT_EQ(f, kDefaultInversionFloor);
+  const double s_emit = f + params.activation_margin * (1.0 - f);
+  int floor_rows = 0, inverted = 0, skipped_keys = 0;
+  double worst = 0.0;
+  for (int trial = 0; trial < 1500; ++trial) {
+    const Vec3 s(u(rng), u(rng), u(rng));
+    if (MinGap(s) < 0.05 || std::abs(std::abs(s.minCoeff()) - f) < 0.02) continue;
+    std::array<Vec3, 4> X;
+    const TetRestRows r = MakeRestRows(&rng, &X);
+    const Mat3 F = RandomRotation(&rng) * s.asDiagonal() * RandomRotation(&rng).transpose();
+    const TetPositions x = PositionsFromG(F, X, Vec3(0.2, -0.1, 0.4));
+    const Vec3 s_ref = IndependentPrincipalStretches(F);
+    std::vector<StrainLimitRow> rows;
+    AppendStrainLimitRows(3, r, x, Mat3::Identity(), params, &rows);  // element 3 as AllRows
+    int expected = 0;
+    for (int i = 0; i < 3; ++i) expected += s_ref[i] < s_emit ? 1 : 0;
+    int found = 0;
+    for (const StrainLimitRow& row : rows) {
+      if (row.key.axis != kStrainFloorAxis) continue;
+      ++found;
+      EXPECT_EQ(row.key.bound, StrainBound::kMin);
+      EXPECT_NEAR(row.C, (s_ref[row.principal_index] - f) / (1.0 - f), 1e-9);
+      Vec12 J_fd;
+      // The key's matched axis can flip where two matches tie (R3): no FD there.
+      if (!CalcFdJacobian(r, x, Mat3::Identity(), params, row.key, 1e-7, &J_fd)) {
+        ++skipped_keys;
+        continue;
+      }
+      worst = std::max(worst, (row.J - J_fd).norm() / std::max(1.0, J_fd.norm()));
+    }
+    EXPECT_EQ(found, expected) << "s = " << s_ref.transpose();
+    floor_rows += found;
+    if (s_ref[2] < 0.0) {
+      ++inverted;
+      EXPECT_GE(CalcStrainLimitViolation(r, x, Mat3::Identity(), params), f / (1.0 - f));
+    }
+  }
+  std::printf("[ floor rows ] %d rows (%d keys flipped), %d inverted states, max rel J err %.2e\n",
+              floor_rows, skipped_keys, inverted, worst);
+  EXPECT_GT(floor_rows, 300);
+  EXPECT_LT(skipped_keys, floor_rows / 20);
+  EXPECT_GT(inverted, 100);
+  EXPECT_LT(worst, 1e-6);
+}
+
+// A body without any limit emits no floor rows: the floor guards limited elements only.
+TEST(StrainLimitRowsTest, InversionFloorNeedsALimit) {
+  const Tet tet = TetFromG(Vec3(1.0, 0.5, -0.3).asDiagonal());
+  StrainLimitSettings settings;  // every axis unlimited
+  std::vector<StrainLimitRow> rows;
+  AppendStrainLimitRows(0, tet.r, tet.x, Mat3::Identity(), CalcStrainLimitParams(settings), &rows);
+  EXPECT_TRUE(rows.empty());
+  settings.s_max[0] = 1.1;
+  AppendStrainLimitRows(0, tet.r, tet.x, Mat3::Identity(), CalcStrainLimitParams(settings), &rows);
+  EXPECT_EQ(rows.size(), 1u);  // s_3 = -0.3: its floor row only (s_1 = 1 is no stretch)
+  settings.inversion_floor = 1.0;
+  EXPECT_THROW(settings.Validate(1, "test"), InputError);
+}
+
 // Pack and Unpack are inverse (the curvature pass decodes the element from a row key).
 TEST(StrainLimitRowsTest, KeyUnpackInvertsPack) {
   for (const int element : {0, 1, 7, 123456}) {
-    for (int axis = 0; axis < 3; ++axis) {
+    for (int axis = 0; axis <= kStrainFloorAxis; ++axis) {
       for (int m = 0; m < 3; ++m) {
         for (const StrainBound bound : {StrainBound::kMin, StrainBound::kMax}) {
           const StrainLimitKey key{element, static_cast<std::int8_t>(axis),
