@@ -55,14 +55,14 @@ void AddToolContactRows(const IslandRows& rows, const btCollisionObject* tool,
 // Stage: J_t rows of the island's deformables' kinematic nodes pinned to the tool (eq. H5).
 void AddDrivenNodeRows(const DeformableWorld& world, const std::vector<IslandBody*>& bodies,
                        const IslandRows& rows, const btRigidBody* tool, double h, const Vec3& o,
-                       const DelassusColumns& columns, ToolJacobian& J_t) {
+                       const std::vector<MatX>& Y, ToolJacobian& J_t) {
   for (int b = 0; b < static_cast<int>(bodies.size()); ++b) {
     const DeformableBody* body = bodies[b]->deformable();
     if (body == nullptr) continue;
     const std::vector<int> nodes = world.driven_nodes(body, tool);
     if (nodes.empty()) continue;
     const double c_K = h * body->settings().stiffness_damping + h * h;
-    AddDrivenNodesToolJacobian(rows, b, *body, nodes, o, c_K, columns, J_t);
+    AddDrivenNodesToolJacobian(rows, b, *body, nodes, o, c_K, Y[b], J_t);
   }
 }
 }  // namespace
@@ -84,13 +84,12 @@ HapticForceLoop HapticForceLoop::Capture(DeformableWorld& world, const btRigidBo
   // Freeze each solved island the tool moves (a nonzero J_t row).
   std::vector<FrozenIsland> islands;
   std::vector<ToolJacobian> jacobians;
-  DelassusColumns columns;
   for (const DeformableWorld::SolvedIsland& solved : world.last_solved_islands()) {
     const IslandRows& rows = *solved.rows;
-    FrozenIsland island = FreezeIsland(loop.h_, *solved.bodies, rows, *solved.multipliers, columns);
+    FrozenIsland island = FreezeIsland(loop.h_, *solved.bodies, rows, *solved.multipliers);
     ToolJacobian J_t = ToolJacobian::Zero(rows.size(), 6);
     AddToolContactRows(rows, tool, world.getCollisionObjectArray(), loop.reference_, J_t);
-    AddDrivenNodeRows(world, *solved.bodies, rows, tool, loop.h_, loop.reference_, columns, J_t);
+    AddDrivenNodeRows(world, *solved.bodies, rows, tool, loop.h_, loop.reference_, island.Y, J_t);
     const int tool_rows = static_cast<int>((J_t.array() != 0.0).rowwise().any().count());
     if (tool_rows == 0) continue;
     loop.num_tool_rows_ += tool_rows;

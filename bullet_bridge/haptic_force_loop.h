@@ -41,10 +41,11 @@ class HapticForceLoop {
   HapticForceLoop() = default;
   // Freezes the islands of the world's last substep that `tool` acts on. The tool's reference
   // point is its centre of mass (the wrench's torque is about it, as in RigidBodyWrench). Call it
-  // right after stepSimulation: it reads the substep's A (a solve with each body's factor), v*,
-  // v, rows and the models' element rotations. Throws InputError for a tool that is not in the
-  // world or is a dynamic rigid body (its motion is the solve's, not the user's). A tool that
-  // touches nothing gives a loop of 0 rows and a zero wrench.
+  // right after stepSimulation: it reads the substep's A^-1 (solves with each body's held
+  // factor), v*, v, rows and the models' element rotations, and changes none of them. Throws
+  // InputError for a tool that is not in the world or is a dynamic rigid body (its motion is the
+  // solve's, not the user's), and for an island whose body holds no factor of this step's A
+  // (FreezeIsland). A tool that touches nothing gives a loop of 0 rows and a zero wrench.
   static HapticForceLoop Capture(DeformableWorld& world, const btRigidBody* tool);
 
   // The wrench on the tool after `motion` since the step, warm-started from the last query.

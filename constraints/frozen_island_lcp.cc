@@ -57,20 +57,39 @@ std::vector<PgsRow> MakePgsRows(const IslandRows& rows) {
 }
 
 namespace {
-// W = J Y with Y_b = A_b^-1 J_b^T per body, symmetrized (round-off).
-MatX CalcDelassus(const std::vector<IslandBody*>& bodies, const IslandRows& rows,
-                  DelassusColumns& columns) {
+// Y_b = A_b^-1 J_b^T (3 num_blocks x rows of b, body_rows order) without changing the body: a
+// deformable's held factor must be this step's A (a solve that would factor is refused).
+MatX SolveColumnsReadOnly(const IslandBody& body, int b, const IslandRows& rows) {
+  const std::vector<int>& body_rows = rows.body_rows(b);
+  MatX Y = MatX::Zero(3 * body.num_blocks(), static_cast<int>(body_rows.size()));
+  for (size_t i = 0; i < body_rows.size(); ++i)
+    rows[body_rows[i]].ForEachEntry([&](int on, int block, const Vec3& J) {
+      if (on == b) Y.col(static_cast<int>(i)).segment<3>(3 * block) += J;
+    });
+  if (Y.cols() == 0) return Y;
+  const DeformableBody* deformable = body.deformable();
+  if (deformable == nullptr) {
+    body.SolveSystemColumns(Y);  // rigid: A = diag(m I, I_world), nothing held
+    return Y;
+  }
+  TAUT_DEMAND(deformable->system().factor_is_current(), "body '", deformable->name(),
+              "': its held factor is not this step's A (its unconstrained solve reused an "
+              "earlier factor and no solve factored A since): freezing the island would have to "
+              "factor it and change the body; turn off factor_reuse for this body");
+  deformable->system().SolveColumns(Y);
+  return Y;
+}
+
+// W = sum_b J_b Y_b, symmetrized (round-off).
+MatX CalcDelassus(const IslandRows& rows, const std::vector<MatX>& Y) {
   const int m = rows.size();
   MatX W = MatX::Zero(m, m);
-  columns.Clear();
-  columns.Build(bodies, rows);
-  for (int b = 0; b < static_cast<int>(bodies.size()); ++b) {
+  for (int b = 0; b < static_cast<int>(Y.size()); ++b) {
     const std::vector<int>& body_rows = rows.body_rows(b);
-    const MatX& Y = columns.Y(b);
     for (size_t i = 0; i < body_rows.size(); ++i)
       rows[body_rows[i]].ForEachEntry([&](int on, int block, const Vec3& J) {
         if (on != b) return;
-        const Eigen::RowVectorXd w_row = J.transpose() * Y.middleRows<3>(3 * block);
+        const Eigen::RowVectorXd w_row = J.transpose() * Y[b].middleRows<3>(3 * block);
         for (size_t k = 0; k < body_rows.size(); ++k) W(body_rows[i], body_rows[k]) += w_row[k];
       });
   }
@@ -79,12 +98,14 @@ MatX CalcDelassus(const std::vector<IslandBody*>& bodies, const IslandRows& rows
 }  // namespace
 
 FrozenIsland FreezeIsland(double h, const std::vector<IslandBody*>& bodies, const IslandRows& rows,
-                          const VecX& lambda, DelassusColumns& columns) {
+                          const VecX& lambda) {
   TAUT_DEMAND(h > 0.0, "FreezeIsland: step h must be > 0 s, got ", h);
   TAUT_DEMAND(lambda.size() == rows.size(), "FreezeIsland: ", lambda.size(), " multipliers for ",
               rows.size(), " rows");
   FrozenIsland island;
-  island.W = CalcDelassus(bodies, rows, columns);
+  for (int b = 0; b < static_cast<int>(bodies.size()); ++b)
+    island.Y.push_back(SolveColumnsReadOnly(*bodies[b], b, rows));
+  island.W = CalcDelassus(rows, island.Y);
   // q0 = C/h + J (v* - v), friction rows J v* (as SqpSolver::BuildQp at the solved iterate v).
   const int m = rows.size();
   island.q0.resize(m);

@@ -4,10 +4,10 @@
 
 #include <vector>
 
-#include "constraints/delassus_columns.h"
 #include "constraints/island_body.h"
 #include "constraints/island_rows.h"
 #include "constraints/pgs_solver.h"
+#include "plugin/deformable_body.h"
 
 namespace taut {
 
@@ -63,19 +63,23 @@ class FrozenIslandLcp {
   VecX q_, lambda_, w_;  // this Solve's q = q0 + J_t u, multipliers and w = W lambda + q
 };
 
-// The frozen QP data of one solved island: W = J A^-1 J^T, q0, the PGS rows and lambda0 (H1).
+// The frozen QP data of one solved island: W = J A^-1 J^T, q0, the PGS rows and lambda0 (H1),
+// and per body b the columns Y_b = A_b^-1 J_b^T (3 num_blocks x rows of b, body_rows order).
 struct FrozenIsland {
   MatX W;
   VecX q0;
   std::vector<PgsRow> rows;
   VecX lambda0;
+  std::vector<MatX> Y;
 };
 
 // Freezes an island as its solve left it: `rows` and `lambda` (IslandSolver::last_rows() and
-// last_multipliers()), the bodies with this step's A, v* and solved v. `columns` gets the
-// columns Y_b = A_b^-1 J_b^T (read by the tool Jacobian of driven nodes). Changes no body.
+// last_multipliers()), the bodies with this step's A, v* and solved v. Changes no body: a
+// deformable's A^-1 comes from its held factor, which must be this step's (true after a dual
+// solve, which used it); throws InputError naming the body otherwise (factor_reuse kept an
+// earlier factor and nothing factored A since).
 FrozenIsland FreezeIsland(double h, const std::vector<IslandBody*>& bodies, const IslandRows& rows,
-                          const VecX& lambda, DelassusColumns& columns);
+                          const VecX& lambda);
 
 // The PGS rows of `rows` (unilateral, bilateral with bounds, friction on its normal's disk),
 // as the dual path builds them (SqpSolver::BuildPgsRows).

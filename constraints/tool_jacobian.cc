@@ -21,7 +21,7 @@ Eigen::Matrix<double, 3, 6> CalcNodeTwistMap(const Vec3& r) {
 
 void AddDrivenNodesToolJacobian(const IslandRows& rows, int b, const DeformableBody& body,
                                 const std::vector<int>& nodes, const Vec3& o, double c_K,
-                                const DelassusColumns& columns, ToolJacobian& J_t) {
+                                const MatX& Y_b, ToolJacobian& J_t) {
   TAUT_DEMAND(J_t.rows() == rows.size(), "AddDrivenNodesToolJacobian: J_t has ", J_t.rows(),
               " rows for ", rows.size(), " island rows");
   const int N = body.num_nodes();
@@ -49,7 +49,7 @@ void AddDrivenNodesToolJacobian(const IslandRows& rows, int b, const DeformableB
     KG.col(j) = out;
   }
   const std::vector<int>& body_rows = rows.body_rows(b);
-  const MatX YtKG = columns.Y(b).transpose() * KG;  // (rows of b x 6)
+  const MatX YtKG = Y_b.transpose() * KG;  // (rows of b x 6)
   for (size_t i = 0; i < body_rows.size(); ++i) J_t.row(body_rows[i]) -= YtKG.row(i);
 }
 

@@ -5,7 +5,6 @@
 
 #include <vector>
 
-#include "constraints/delassus_columns.h"
 #include "constraints/frozen_island_lcp.h"
 #include "constraints/island_rows.h"
 #include "plugin/deformable_body.h"
@@ -22,10 +21,10 @@ Eigen::Matrix<double, 1, 6> CalcRigidPointToolRow(const Vec3& d, const Vec3& q, 
 // the free nodes' v* = A^-1 (b - c_K K_fk v_kin) follows them (DeformableBody::BeginStep), so
 //   J_t = J_k G - c_K Y^T K G,   Y = A^-1 J^T,  c_K = h beta + h^2.                  (H5)
 // K is the body model's stiffness at its last rotation update (the step's x0, unless the model
-// was updated since); `columns` holds Y of the island (FreezeIsland). Throws InputError for a
-// node index out of range or one that is not kinematic.
+// was updated since); Y_b are body b's columns (FrozenIsland::Y). Throws InputError for a node
+// index out of range or one that is not kinematic.
 void AddDrivenNodesToolJacobian(const IslandRows& rows, int b, const DeformableBody& body,
                                 const std::vector<int>& nodes, const Vec3& o, double c_K,
-                                const DelassusColumns& columns, ToolJacobian& J_t);
+                                const MatX& Y_b, ToolJacobian& J_t);
 
 }  // namespace taut

@@ -81,9 +81,12 @@ TEST(HapticForceLoopTest, NoMotionGivesTheStepsWrench) {
   EXPECT_EQ(loop.num_islands(), 1);
   EXPECT_GT(loop.num_tool_rows(), 0);
   const HapticWrench wrench = loop.CalcToolWrench(ToolMotion());
-  std::printf("table: report %.6f N, loop %.6f N (%d rows, %d tool rows, %d sweeps, %.1f us)\n",
-              reported.force.z(), wrench.force.z(), loop.lcp().size(), loop.num_tool_rows(),
-              wrench.sweeps, wrench.microseconds);
+  std::printf(
+      "table: report %.6f N, loop %.6f N, |difference| %.1e N, torque %.1e N m (%d rows, "
+      "%d tool rows, %d sweeps, %.1f us)\n",
+      reported.force.z(), wrench.force.z(), (wrench.force - reported.force).norm(),
+      (wrench.torque - reported.torque).norm(), loop.lcp().size(), loop.num_tool_rows(),
+      wrench.sweeps, wrench.microseconds);
   EXPECT_TRUE(wrench.converged);
   EXPECT_LT((wrench.force - reported.force).norm(), 1e-3 * reported.force.norm());
   EXPECT_LT((wrench.torque - reported.torque).norm(), 1e-3 * reported.force.norm() * 0.1);
