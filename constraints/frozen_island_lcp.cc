@@ -73,9 +73,10 @@ MatX SolveColumnsReadOnly(const IslandBody& body, int b, const IslandRows& rows)
     return Y;
   }
   TAUT_DEMAND(deformable->system().factor_is_current(), "body '", deformable->name(),
-              "': its held factor is not this step's A (its unconstrained solve reused an "
-              "earlier factor and no solve factored A since): freezing the island would have to "
-              "factor it and change the body; turn off factor_reuse for this body");
+              "': its held factor is not this step's A (it was not stepped, or its "
+              "unconstrained solve reused an earlier factor and no solve factored A since): "
+              "freezing the island would have to factor A and change the body; turn off "
+              "factor_reuse for this body");
   deformable->system().SolveColumns(Y);
   return Y;
 }

@@ -8,9 +8,14 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <string>
 
 #include "bullet_bridge/eigen_bullet.h"
+#include "constraints/deformable_island_body.h"
+#include "constraints/node_height_source.h"
+#include "demos/scenes/bullet_world_holder.h"
 #include "demos/scenes/finger_scene.h"
+#include "plugin/box_tet_mesher.h"
 
 namespace taut {
 namespace {
@@ -258,6 +263,34 @@ TEST(HapticForceLoopTest, BadToolsThrow) {
   scene->world().addRigidBody(&dynamic);
   EXPECT_THROW(HapticForceLoop::Capture(scene->world(), &dynamic), InputError);
   scene->world().removeRigidBody(&dynamic);
+}
+
+// An island whose body holds no factor of this step's A (here: a body never stepped, as after an
+// unconstrained solve that reused an older factor by PCG with no solve of A since) is refused
+// with an InputError naming the body, rather than factored behind the world's back.
+TEST(HapticForceLoopTest, IslandWithoutThisStepsFactorIsRefused) {
+  BulletWorldHolder holder;
+  DeformableBodySettings settings;
+  settings.name = "unfactored block";
+  settings.material = {1e5, 0.3, 1000.0};
+  DeformableBody* body =
+      holder.world.AddTetBody(MakeBoxTetMesh(Vec3(0.1, 0.1, 0.05), 2, 2, 1), settings);
+  ASSERT_FALSE(body->system().factor_is_current());
+  DeformableIslandBody island_body(*body);
+  const std::vector<IslandBody*> bodies = {&island_body};
+  NodeHeightSource floor(*body, 0.01, 1e-3, 0);  // the bottom nodes below z_min: active rows
+  const std::vector<ConstraintSource*> sources = {&floor};
+  IslandRows rows;
+  rows.Collect(kDt, bodies, sources, {body->v()}, 1.0);
+  ASSERT_FALSE(rows.empty());
+  try {
+    FreezeIsland(kDt, bodies, rows, VecX::Zero(rows.size()));
+    ADD_FAILURE() << "FreezeIsland solved with a factor that is not this step's";
+  } catch (const InputError& e) {
+    std::printf("refused: %s\n", e.what());
+    EXPECT_NE(std::string(e.what()).find("unfactored block"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(body->system().factor_is_current());  // nothing was factored
 }
 
 }  // namespace
