@@ -16,6 +16,7 @@
 #include "demos/scenes/bullet_world_holder.h"
 #include "demos/scenes/finger_scene.h"
 #include "plugin/box_tet_mesher.h"
+#include "tests/allocation_counter.h"
 
 namespace taut {
 namespace {
@@ -252,6 +253,24 @@ TEST(HapticForceLoopTest, QueriesLeaveTheWorldBitIdentical) {
     const Vec3 b = FindReportedWrench(twin->world(), twin->table()).force;
     EXPECT_EQ(a, b) << step;
   }
+}
+
+// A query allocates nothing (a haptic thread must not wait on the heap).
+TEST(HapticForceLoopTest, QueriesAllocateNothing) {
+  std::unique_ptr<FingerScene> scene = MakeHeldFinger(1.0);
+  HapticForceLoop loop = HapticForceLoop::Capture(scene->world(), scene->bone());
+  const btTransform pose = scene->bone()->getWorldTransform();
+  loop.CalcToolWrench(ToolMotion());
+  testing::ScopedAllocationCounter counter;
+  for (int k = 0; k < 20; ++k) {
+    ToolMotion motion;
+    motion.displacement = Vec3(1e-6 * k, 0.0, -1e-7 * k);
+    loop.CalcToolWrench(motion);
+    btTransform moved = pose;
+    moved.setOrigin(pose.getOrigin() + btVector3(0, 0, -1e-7 * k));
+    loop.CalcToolWrench(moved);
+  }
+  EXPECT_EQ(counter.count(), 0u);
 }
 
 // Bad tools: a dynamic rigid body, or one not in the world.
