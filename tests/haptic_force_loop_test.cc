@@ -9,6 +9,8 @@
 #include <cstdio>
 #include <memory>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include "bullet_bridge/eigen_bullet.h"
 #include "constraints/deformable_island_body.h"
@@ -271,6 +273,28 @@ TEST(HapticForceLoopTest, QueriesAllocateNothing) {
     loop.CalcToolWrench(moved);
   }
   EXPECT_EQ(counter.count(), 0u);
+}
+
+// A loop is a standalone value: queried on another thread while the world steps on, it answers
+// exactly what a copy answers with the world idle.
+TEST(HapticForceLoopTest, LoopAnswersTheSameWhileTheWorldSteps) {
+  std::unique_ptr<FingerScene> scene = MakeHeldFinger(1.0);
+  HapticForceLoop loop = HapticForceLoop::Capture(scene->world(), scene->bone());
+  HapticForceLoop copy = loop;
+  auto query = [](HapticForceLoop& l, std::vector<Vec3>& forces) {
+    for (int k = 0; k < 200; ++k) {
+      ToolMotion motion;
+      motion.displacement = Vec3(2e-6 * std::sin(0.1 * k), 0.0, -1e-6 * (1.0 - std::cos(0.05 * k)));
+      forces.push_back(l.CalcToolWrench(motion).force);
+    }
+  };
+  std::vector<Vec3> during, idle;
+  std::thread haptic([&] { query(loop, during); });
+  for (int step = 0; step < 10; ++step) scene->Step(kDt);
+  haptic.join();
+  query(copy, idle);
+  ASSERT_EQ(during.size(), idle.size());
+  for (size_t k = 0; k < idle.size(); ++k) EXPECT_EQ(during[k], idle[k]) << k;
 }
 
 // Bad tools: a dynamic rigid body, or one not in the world.
