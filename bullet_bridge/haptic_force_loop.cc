@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "bullet_bridge/eigen_bullet.h"
+#include "bullet_bridge/rigid_island_body.h"
 #include "constraints/row_key_layouts.h"
 #include "constraints/tool_jacobian.h"
 
@@ -52,6 +53,15 @@ void AddToolContactRows(const IslandRows& rows, const btCollisionObject* tool,
   }
 }
 
+// The island index of a dynamic tool's rigid island body, or -1.
+int FindToolBody(const std::vector<IslandBody*>& bodies, const btRigidBody* tool) {
+  for (size_t b = 0; b < bodies.size(); ++b) {
+    const auto* rigid = dynamic_cast<const RigidIslandBody*>(bodies[b]);
+    if (rigid != nullptr && rigid->rigid() == tool) return static_cast<int>(b);
+  }
+  return -1;
+}
+
 // Stage: J_t rows of the island's deformables' kinematic nodes pinned to the tool (eq. H5).
 void AddDrivenNodeRows(const DeformableWorld& world, const std::vector<IslandBody*>& bodies,
                        const IslandRows& rows, const btRigidBody* tool, double h, const Vec3& o,
@@ -72,9 +82,6 @@ HapticForceLoop HapticForceLoop::Capture(DeformableWorld& world, const btRigidBo
                   tool->getWorldArrayIndex() < world.getNumCollisionObjects() &&
                   world.getCollisionObjectArray()[tool->getWorldArrayIndex()] == tool,
               "HapticForceLoop::Capture: the tool is not a rigid body of this world");
-  TAUT_DEMAND(tool->isStaticOrKinematicObject(),
-              "HapticForceLoop::Capture: the tool must be static or kinematic (driven by the "
-              "user), not a dynamic rigid body");
   HapticForceLoop loop;
   loop.h_ = world.last_substep_forces().h;
   loop.tool_transform_ = tool->getWorldTransform();
@@ -86,8 +93,11 @@ HapticForceLoop HapticForceLoop::Capture(DeformableWorld& world, const btRigidBo
   std::vector<ToolJacobian> jacobians;
   for (const DeformableWorld::SolvedIsland& solved : world.last_solved_islands()) {
     const IslandRows& rows = *solved.rows;
-    FrozenIsland island = FreezeIsland(loop.h_, *solved.bodies, rows, *solved.multipliers);
+    const int prescribed = FindToolBody(*solved.bodies, tool);
+    FrozenIsland island =
+        FreezeIsland(loop.h_, *solved.bodies, rows, *solved.multipliers, prescribed);
     ToolJacobian J_t = ToolJacobian::Zero(rows.size(), 6);
+    if (prescribed >= 0) AddPrescribedBodyToolJacobian(rows, prescribed, J_t);
     AddToolContactRows(rows, tool, world.getCollisionObjectArray(), loop.reference_, J_t);
     AddDrivenNodeRows(world, *solved.bodies, rows, tool, loop.h_, loop.reference_, island.Y, J_t);
     const int tool_rows = static_cast<int>((J_t.array() != 0.0).rowwise().any().count());

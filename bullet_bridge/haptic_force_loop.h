@@ -26,12 +26,14 @@ struct HapticWrench {
   double microseconds = 0.0;   // wall time of the query
 };
 
-// The contact and limit LCP of the islands a static or kinematic rigid body (the tool: a probe,
-// or the bone that drives a finger's flesh) acts on, frozen at the end of a world step, as a
-// function of the tool's motion since then (SOFA's LCPForceFeedback; docs/haptics.md):
+// The contact and limit LCP of the islands a rigid body (the tool: a probe, an instrument, or the
+// bone that drives a finger's flesh) acts on, frozen at the end of a world step, as a function of
+// the tool's motion since then (SOFA's LCPForceFeedback; docs/haptics.md):
 //   u = (displacement / h; rotation / h),  w = W lambda + q0 + J_t u,  wrench = J_t^T lambda / h
-// (constraints/frozen_island_lcp.h eq. H1-H2). The tool acts through contact rows whose partner
-// it is (eq. H4) and through the kinematic nodes AttachNodesToRigidBody pinned to it (eq. H5).
+// (constraints/frozen_island_lcp.h eq. H1-H2). A static or kinematic tool acts through contact
+// rows whose partner it is (eq. H4) and through the kinematic nodes AttachNodesToRigidBody pinned
+// to it (eq. H5); a dynamic tool through its own rows in its island (contacts, attachments,
+// Bullet's manifolds and joints; eq. H6), its velocity taken from the user: it leaves W.
 // W, q0, J_t and the warm start are copies: queries read nothing of the world, so they may run
 // on another thread while the world steps on, and leave the simulation bit-identical. With no
 // motion the wrench is the step's own on the tool (to the PGS tolerance); a query answers for
@@ -43,9 +45,9 @@ class HapticForceLoop {
   // point is its centre of mass (the wrench's torque is about it, as in RigidBodyWrench). Call it
   // right after stepSimulation: it reads the substep's A^-1 (solves with each body's held
   // factor), v*, v, rows and the models' element rotations, and changes none of them. Throws
-  // InputError for a tool that is not in the world or is a dynamic rigid body (its motion is the
-  // solve's, not the user's), and for an island whose body holds no factor of this step's A
-  // (FreezeIsland). A tool that touches nothing gives a loop of 0 rows and a zero wrench.
+  // InputError for a tool that is not in the world, and for an island whose body holds no factor
+  // of this step's A (FreezeIsland). A tool that touches nothing gives a loop of 0 rows and a
+  // zero wrench.
   static HapticForceLoop Capture(DeformableWorld& world, const btRigidBody* tool);
 
   // The wrench on the tool after `motion` since the step, warm-started from the last query.

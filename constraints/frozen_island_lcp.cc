@@ -99,25 +99,31 @@ MatX CalcDelassus(const IslandRows& rows, const std::vector<MatX>& Y) {
 }  // namespace
 
 FrozenIsland FreezeIsland(double h, const std::vector<IslandBody*>& bodies, const IslandRows& rows,
-                          const VecX& lambda) {
+                          const VecX& lambda, int prescribed) {
   TAUT_DEMAND(h > 0.0, "FreezeIsland: step h must be > 0 s, got ", h);
   TAUT_DEMAND(lambda.size() == rows.size(), "FreezeIsland: ", lambda.size(), " multipliers for ",
               rows.size(), " rows");
+  TAUT_DEMAND(prescribed >= -1 && prescribed < static_cast<int>(bodies.size()),
+              "FreezeIsland: prescribed body ", prescribed, " of an island of ", bodies.size());
   FrozenIsland island;
   for (int b = 0; b < static_cast<int>(bodies.size()); ++b)
-    island.Y.push_back(SolveColumnsReadOnly(*bodies[b], b, rows));
+    island.Y.push_back(b == prescribed
+                           ? MatX::Zero(3 * bodies[b]->num_blocks(), rows.body_rows(b).size())
+                           : SolveColumnsReadOnly(*bodies[b], b, rows));
   island.W = CalcDelassus(rows, island.Y);
-  // q0 = C/h + J (v* - v), friction rows J v* (as SqpSolver::BuildQp at the solved iterate v).
+  // q0 = C/h + J (v_ref - v), friction rows J v_ref, with v_ref = v* (a prescribed body: its
+  // solved v), as SqpSolver::BuildQp at the solved iterate v.
   const int m = rows.size();
   island.q0.resize(m);
   for (int c = 0; c < m; ++c) {
     const ConstraintRow& row = rows[c];
-    double jv_star = 0.0, jv = 0.0;
+    double jv_ref = 0.0, jv = 0.0;
     row.ForEachEntry([&](int body, int block, const Vec3& J) {
-      jv_star += J.dot(bodies[body]->v_star().segment<3>(3 * block));
-      jv += J.dot(bodies[body]->v().segment<3>(3 * block));
+      const IslandBody& on = *bodies[body];
+      jv_ref += J.dot((body == prescribed ? on.v() : on.v_star()).segment<3>(3 * block));
+      jv += J.dot(on.v().segment<3>(3 * block));
     });
-    island.q0[c] = row.friction_of > 0 ? jv_star : row.C / h + jv_star - jv;
+    island.q0[c] = row.friction_of > 0 ? jv_ref : row.C / h + jv_ref - jv;
   }
   island.rows = MakePgsRows(rows);
   island.lambda0 = lambda;

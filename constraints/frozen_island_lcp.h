@@ -77,9 +77,11 @@ struct FrozenIsland {
 // last_multipliers()), the bodies with this step's A, v* and solved v. Changes no body: a
 // deformable's A^-1 comes from its held factor, which must be this step's (true after a dual
 // solve, which used it); throws InputError naming the body otherwise (factor_reuse kept an
-// earlier factor and nothing factored A since).
+// earlier factor and nothing factored A since). Island body `prescribed` (or -1: none) is a
+// tool whose velocity is the user's, not the solve's: it leaves W (no mobility) and enters q0
+// with its solved velocity, its rows moved by J_t instead (AddPrescribedBodyToolJacobian).
 FrozenIsland FreezeIsland(double h, const std::vector<IslandBody*>& bodies, const IslandRows& rows,
-                          const VecX& lambda);
+                          const VecX& lambda, int prescribed = -1);
 
 // The PGS rows of `rows` (unilateral, bilateral with bounds, friction on its normal's disk),
 // as the dual path builds them (SqpSolver::BuildPgsRows).

@@ -9,6 +9,18 @@ Eigen::Matrix<double, 1, 6> CalcRigidPointToolRow(const Vec3& d, const Vec3& q, 
   return row;
 }
 
+void AddPrescribedBodyToolJacobian(const IslandRows& rows, int b, ToolJacobian& J_t) {
+  TAUT_DEMAND(J_t.rows() == rows.size(), "AddPrescribedBodyToolJacobian: J_t has ", J_t.rows(),
+              " rows for ", rows.size(), " island rows");
+  for (int c : rows.body_rows(b))
+    rows[c].ForEachEntry([&](int on, int block, const Vec3& J) {
+      if (on != b) return;
+      TAUT_DEMAND(block == 0 || block == 1, "AddPrescribedBodyToolJacobian: row ", c, " has block ",
+                  block, " on body ", b, ", which is not rigid");
+      J_t.row(c).segment<3>(3 * block) += J.transpose();
+    });
+}
+
 namespace {
 // (3 x 6) G_n: node velocity u_lin + u_ang x r = [I, -[r]x] u for r = x_n - o.
 Eigen::Matrix<double, 3, 6> CalcNodeTwistMap(const Vec3& r) {

@@ -16,6 +16,11 @@ namespace taut {
 //   w = J_A v - d . (u_lin + u_ang x (q - o))  =>  J_t,c = -[d; (q - o) x d].        (H4)
 Eigen::Matrix<double, 1, 6> CalcRigidPointToolRow(const Vec3& d, const Vec3& q, const Vec3& o);
 
+// Adds to J_t the entries of the rows on island body `b`, a rigid tool whose twist (linear and
+// angular velocity, blocks 0 and 1, angular about its centre of mass) is prescribed:
+//   w = J_other v_other + J_b u  =>  J_t,c += [J_c,block0; J_c,block1].               (H6)
+void AddPrescribedBodyToolJacobian(const IslandRows& rows, int b, ToolJacobian& J_t);
+
 // Adds to J_t (rows.size() x 6) the part of the kinematic nodes `nodes` of island body `b`
 // (`body`) that move with the tool: node n's velocity is G_n u = u_lin + u_ang x (x_n - o), and
 // the free nodes' v* = A^-1 (b - c_K K_fk v_kin) follows them (DeformableBody::BeginStep), so

@@ -301,11 +301,55 @@ TEST(HapticForceLoopTest, LoopAnswersTheSameWhileTheWorldSteps) {
 TEST(HapticForceLoopTest, BadToolsThrow) {
   std::unique_ptr<FingerScene> scene = MakeHeldFinger();
   btSphereShape shape(0.01);
-  btRigidBody dynamic(1.0, nullptr, &shape, btVector3(1e-4, 1e-4, 1e-4));
-  EXPECT_THROW(HapticForceLoop::Capture(scene->world(), &dynamic), InputError);
-  scene->world().addRigidBody(&dynamic);
-  EXPECT_THROW(HapticForceLoop::Capture(scene->world(), &dynamic), InputError);
-  scene->world().removeRigidBody(&dynamic);
+  btRigidBody outside(1.0, nullptr, &shape, btVector3(1e-4, 1e-4, 1e-4));
+  EXPECT_THROW(HapticForceLoop::Capture(scene->world(), &outside), InputError);
+  EXPECT_THROW(HapticForceLoop::Capture(scene->world(), nullptr), InputError);
+  // In the world but touching nothing: no rows, no force.
+  outside.setWorldTransform(btTransform(btQuaternion::getIdentity(), btVector3(0, 0, 1)));
+  scene->world().addRigidBody(&outside);
+  HapticForceLoop loop = HapticForceLoop::Capture(scene->world(), &outside);
+  EXPECT_EQ(loop.lcp().size(), 0);
+  ToolMotion motion;
+  motion.displacement = Vec3(0.0, 0.0, -1e-3);
+  EXPECT_EQ(loop.CalcToolWrench(motion).force, Vec3::Zero());
+  scene->world().removeRigidBody(&outside);
+}
+
+// A dynamic tool: a 0.2 kg rigid box resting on a soft block on the ground, in the block's
+// island. Its velocity becomes the user's (it leaves W): with no motion the loop gives the box's
+// reported wrench, and pressing it down raises the force monotonically.
+TEST(HapticForceLoopTest, DynamicToolInTheIsland) {
+  BulletWorldHolder holder;
+  holder.AddStaticGround(1.0);
+  DeformableBodySettings settings;
+  settings.name = "soft block";
+  settings.material = {2e5, 0.3, 1000.0};
+  settings.mass_damping = 5.0;
+  holder.world.AddTetBody(MakeBoxTetMesh(Vec3(0.1, 0.1, 0.04), 4, 4, 2), settings);
+  btRigidBody* box = holder.AddRigidBody(std::make_unique<btBoxShape>(btVector3(0.02, 0.02, 0.01)),
+                                         0.2, btVector3(0.05, 0.05, 0.0505), 0.5);
+  for (int step = 0; step < 300; ++step) holder.world.stepSimulation(kDt, 1, kDt);
+  const RigidBodyWrench reported = FindReportedWrench(holder.world, box);
+  ASSERT_GT(reported.force.z(), 1.0);  // carries the box's weight, about 1.96 N
+  HapticForceLoop loop = HapticForceLoop::Capture(holder.world, box);
+  ASSERT_EQ(loop.num_islands(), 1);
+  const HapticWrench w0 = loop.CalcToolWrench(ToolMotion());
+  std::printf("dynamic box: report %.6f N, loop %.6f N (%d rows, %d tool rows, %d sweeps)\n",
+              reported.force.z(), w0.force.z(), loop.lcp().size(), loop.num_tool_rows(), w0.sweeps);
+  // This island (102 rows on 225 free DOFs) takes the primal path, whose multipliers solve the
+  // frozen LCP to its own tolerance (measured 5e-5 of the force).
+  EXPECT_GT(holder.world.last_step_stats().islands_primal, 0);
+  EXPECT_LT((w0.force - reported.force).norm(), 1e-3 * reported.force.norm());
+  EXPECT_LT((w0.torque - reported.torque).norm(), 1e-3 * reported.force.norm() * 0.02);
+  double last = w0.force.z();
+  for (double d : {0.5e-6, 1e-6, 2e-6, 4e-6}) {
+    ToolMotion motion;
+    motion.displacement = Vec3(0.0, 0.0, -d);
+    const HapticWrench w = loop.CalcToolWrench(motion);
+    std::printf("box down %.1f um: %.4f N (%d sweeps)\n", 1e6 * d, w.force.z(), w.sweeps);
+    EXPECT_GT(w.force.z(), last);
+    last = w.force.z();
+  }
 }
 
 // An island whose body holds no factor of this step's A (here: a body never stepped, as after an
