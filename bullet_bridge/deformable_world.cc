@@ -227,6 +227,7 @@ void DeformableWorld::RemoveDeformableBody(DeformableBody* body) {
   TAUT_DEMAND(it != bodies_.end(), "RemoveDeformableBody: body is not in this world");
   removeCollisionObject(&(*it)->collision_object());
   forces_.Clear(forces_.h);  // they may name the body
+  islands_solved_ = false;
   for (auto pair = pair_contacts_.begin(); pair != pair_contacts_.end();)
     pair = (pair->first.first == it->get() || pair->first.second == it->get())
                ? pair_contacts_.erase(pair)
@@ -321,6 +322,7 @@ void DeformableWorld::StepDeformables(double h, btContactSolverInfo& info, int& 
   stats_.ms_stage_solve_islands = LapMs(lap);
   EndSteps(h);     // 7. integrate (Bullet integrates the rigid transforms next)
   ReportForces();  // 8. forces out (timed with stage 7: a copy of the solved rows)
+  islands_solved_ = true;
   stats_.ms_stage_end_steps = LapMs(lap);
   SumStageStats();  // 8. stats
 }
@@ -623,6 +625,31 @@ std::vector<Entry> SelectBodyEntries(const std::vector<Entry>& all, const Deform
 }
 }  // namespace
 
+std::vector<DeformableWorld::SolvedIsland> DeformableWorld::last_solved_islands() const {
+  std::vector<SolvedIsland> solved;
+  if (!islands_solved_) return solved;
+  for (int i = 0; i < islands_.num_islands(); ++i) {
+    const Island& island = islands_.island(i);
+    if (island.sources.empty()) continue;  // not solved this substep
+    const IslandSolver& solver = bodies_[island.first_deformable]->solver;
+    solved.push_back({&island.bodies, &solver.last_rows(), &solver.last_multipliers()});
+  }
+  return solved;
+}
+
+std::vector<int> DeformableWorld::driven_nodes(const DeformableBody* body,
+                                               const btRigidBody* rigid) const {
+  TAUT_DEMAND(HasBody(body), "driven_nodes: deformable body is not in this world");
+  std::vector<int> nodes;
+  for (const auto& entry : bodies_) {
+    if (&entry->object->body() != body) continue;
+    for (const Entry::Attachment& attachment : entry->attachments)
+      if (attachment.rigid == rigid)
+        nodes.insert(nodes.end(), attachment.nodes.begin(), attachment.nodes.end());
+  }
+  return nodes;
+}
+
 std::vector<DeformableContactPoint> DeformableWorld::last_contacts(
     const DeformableBody* body) const {
   TAUT_DEMAND(HasBody(body), "last_contacts: deformable body is not in this world");
@@ -643,6 +670,7 @@ bool DeformableWorld::HasBody(const DeformableBody* body) const {
 void DeformableWorld::solveConstraints(btContactSolverInfo& info) {
   const double h = static_cast<double>(info.m_timeStep);
   forces_.Clear(h);
+  islands_solved_ = false;
   if (bodies_.empty()) {
     btDiscreteDynamicsWorld::solveConstraints(info);
     return;

@@ -150,6 +150,22 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   // when the body is not in this world.
   std::vector<LimitRowMultiplier> last_limit_multipliers(const DeformableBody* body) const;
 
+  // The islands the last substep solved, as the forces out read them: their bodies (with this
+  // substep's A, v* and solved v), the rows at the solved velocities and their multipliers. For
+  // tools that re-solve them (bullet_bridge/haptic_force_loop.h). Empty before the first
+  // substep, after a SimulationError, RemoveDeformableBody or RestoreSnapshot; valid until the
+  // next of these or the next step.
+  struct SolvedIsland {
+    const std::vector<IslandBody*>* bodies = nullptr;
+    const IslandRows* rows = nullptr;
+    const VecX* multipliers = nullptr;
+  };
+  std::vector<SolvedIsland> last_solved_islands() const;
+  // The nodes of `body` that AttachNodesToRigidBody pinned to the static or kinematic `rigid`
+  // (kinematic nodes it drives), empty when none. Throws InputError when the body is not in this
+  // world.
+  std::vector<int> driven_nodes(const DeformableBody* body, const btRigidBody* rigid) const;
+
   // State snapshots (bullet_bridge/world_snapshot.h), between stepSimulation calls: everything
   // the next step depends on (deformables, warm starts, rigid bodies, joints, Bullet's contact
   // manifolds, the substep clock, the last step's statistics and forces), so a restored world
@@ -277,6 +293,9 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   StepStats stats_;
   StepStats call_stats_;  // totals of the last stepSimulation call
   SubstepForces forces_;  // forces out of the last substep
+
+  // islands_ hold the last substep's solved islands (last_solved_islands).
+  bool islands_solved_ = false;
 };
 
 }  // namespace taut

@@ -61,6 +61,7 @@ class IslandBuilder {
 
   int num_islands() const { return num_islands_; }
   Island& island(int i) { return islands_[i]; }
+  const Island& island(int i) const { return islands_[i]; }
   // Island of deformable body d (after MakeDeformableIslands).
   int island_of_deformable(int d) { return island_of_root_[union_find_.Find(d)]; }
   // Island of union-find index `index`, or -1 for a rigid-only island.

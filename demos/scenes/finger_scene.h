@@ -118,6 +118,10 @@ class FingerScene : public Scene {
   const TetMesh& body_mesh() const { return *body_mesh_; }
   // Nodes pinned to the bone.
   const std::vector<int>& bone_nodes() const { return bone_nodes_; }
+  // The kinematic bone, the static table and the current press's finger (null between presses).
+  btRigidBody* bone() const { return bone_; }
+  btRigidBody* table() const { return table_; }
+  DeformableBody* finger() const { return finger_; }
 
  private:
   // Adds the static frictionless table (top at z = 0) and the kinematic bone, a thin capsule of
