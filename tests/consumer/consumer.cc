@@ -1,8 +1,9 @@
 // Installed-package check: a cantilever beam clamped at x = 0 must sag under gravity, keep its
-// clamped nodes in place and stay finite. Returns 0 on success, 1 otherwise.
+// clamped nodes in place and stay finite. Returns 0 on success, 1 otherwise. Includes only the
+// public headers <taut/NAME.h> (cmake/TautPublicHeaders.cmake), as a user would.
 #include <btBulletDynamicsCommon.h>
-#include <bullet_bridge/deformable_world.h>
-#include <plugin/box_tet_mesher.h>
+#include <taut/box_tet_mesher.h>
+#include <taut/deformable_world.h>
 
 #include <cmath>
 #include <cstdio>
