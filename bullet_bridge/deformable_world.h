@@ -56,8 +56,9 @@ struct WorldSolverOf<btMultiBodyDynamicsWorld> {
 // btDiscreteDynamicsWorld's.
 //
 // BulletWorld is btDiscreteDynamicsWorld (DeformableWorld) or btMultiBodyDynamicsWorld
-// (DeformableMultiBodyWorld, bullet_bridge/deformable_multibody_world.h): there the links of
-// btMultiBodies that touch a deformable join its island as MultiBodyIslandBody (two-way coupling).
+// (DeformableMultiBodyWorld, below): there a btMultiBody whose link collider touches a deformable
+// joins its island as a MultiBodyIslandBody with its joint motors as rows (two-way coupling,
+// docs/architecture.md §4); without deformables every substep is exactly the Bullet world's.
 template <class BulletWorld>
 class DeformableWorldOf : public BulletWorld {
  public:
@@ -174,7 +175,8 @@ class DeformableWorldOf : public BulletWorld {
   // State snapshots (bullet_bridge/world_snapshot.h), between stepSimulation calls: everything
   // the next step depends on (deformables, warm starts, rigid bodies, joints, Bullet's contact
   // manifolds, the substep clock, the last step's statistics and forces), so a restored world
-  // continues bit-identically to the one it was saved from. A snapshot fits this world and any
+  // continues bit-identically to the one it was saved from (in a DeformableMultiBodyWorld the
+  // multibodies' state is not part of it). A snapshot fits this world and any
   // world built the same way (same bodies, objects and joints in the same order).
   WorldSnapshot SaveSnapshot() const;
   // Throws InputError saying what does not match, and changes nothing, when the snapshot is of a

@@ -29,10 +29,16 @@ const btMultiBodyLinkCollider* FindCollider(const btMultiBody& body, int link) {
 
 MultiBodyIslandBody::MultiBodyIslandBody(btMultiBody* body) : body_(body) {
   TAUT_DEMAND(body != nullptr, "MultiBodyIslandBody: multibody is null");
-  num_velocities_ = CountMultiBodyVelocities(*body);
-  TAUT_DEMAND(num_velocities_ <= kMaxVelocities, "multibody with ", body->getNumDofs(),
+  FitSizes();
+}
+
+void MultiBodyIslandBody::FitSizes() {
+  const int count = CountMultiBodyVelocities(*body_);
+  if (count == num_velocities_) return;
+  TAUT_DEMAND(count <= kMaxVelocities, "multibody with ", body_->getNumDofs(),
               " joint dofs: a deformable island takes at most ", kMaxVelocities - 6);
-  num_blocks_ = (num_velocities_ + 2) / 3;
+  num_velocities_ = count;
+  num_blocks_ = (count + 2) / 3;
   const int n = 3 * num_blocks_;
   v_star_.setZero(n);
   v_.setZero(n);
@@ -42,6 +48,7 @@ MultiBodyIslandBody::MultiBodyIslandBody(btMultiBody* body) : body_(body) {
 }
 
 void MultiBodyIslandBody::BeginStep(double /*h*/) {
+  FitSizes();  // the world keeps an island body across steps; its multibody may have changed
   v_star_.setZero();
   v_star_.head(num_velocities_) = GetMultiBodyVelocity(*body_);
   v_ = v_star_;

@@ -70,12 +70,15 @@ class MultiBodyIslandBody final : public IslandBody {
   btMultiBody* multibody() const { return body_; }
 
  private:
+  // Sizes of the vectors and matrices for the body's dofs now; throws InputError beyond
+  // kMaxVelocities.
+  void FitSizes();
   // W = M^-1 by columns (zero rows and columns for the padding and a fixed base).
   void CalcMobility();
 
   btMultiBody* body_;
-  int num_velocities_;  // 6 + dofs
-  int num_blocks_;
+  int num_velocities_ = -1;  // 6 + dofs
+  int num_blocks_ = 0;
   VecX v_star_, v_;
   MatX W_, M_;
   MatX newton_added_;
