@@ -4,10 +4,12 @@
 #include <BulletCollision/CollisionShapes/btCompoundShape.h>
 #include <BulletCollision/CollisionShapes/btPolyhedralConvexShape.h>
 #include <BulletDynamics/Dynamics/btRigidBody.h>
+#include <BulletDynamics/Featherstone/btMultiBodyLinkCollider.h>
 
 #include <algorithm>
 #include <chrono>
 #include <limits>
+#include <type_traits>
 
 #include "bullet_bridge/body_pose.h"
 #include "bullet_bridge/collision_filter.h"
@@ -33,10 +35,11 @@ double LapMs(std::chrono::steady_clock::time_point& lap) {
 }
 }  // namespace
 
-DeformableWorld::DeformableWorld(btDispatcher* dispatcher, btBroadphaseInterface* broadphase,
-                                 btConstraintSolver* solver,
-                                 btCollisionConfiguration* configuration)
-    : btDiscreteDynamicsWorld(dispatcher, broadphase, solver, configuration) {
+template <class BulletWorld>
+DeformableWorldOf<BulletWorld>::DeformableWorldOf(btDispatcher* dispatcher,
+                                                  btBroadphaseInterface* broadphase, Solver* solver,
+                                                  btCollisionConfiguration* configuration)
+    : BulletWorld(dispatcher, broadphase, solver, configuration) {
   // Bullet must never build contact manifolds for deformables: taut detects those itself.
   if (auto* collision_dispatcher = dynamic_cast<btCollisionDispatcher*>(dispatcher)) {
     for (int type = 0; type < MAX_BROADPHASE_COLLISION_TYPES; ++type) {
@@ -48,65 +51,77 @@ DeformableWorld::DeformableWorld(btDispatcher* dispatcher, btBroadphaseInterface
   }
 }
 
-DeformableWorld::~DeformableWorld() {
-  for (auto& body : bodies_) removeCollisionObject(&body->collision_object());
+template <class BulletWorld>
+DeformableWorldOf<BulletWorld>::~DeformableWorldOf() {
+  for (auto& body : bodies_) this->removeCollisionObject(&body->collision_object());
 }
 
-DeformableBody* DeformableWorld::AddTetBody(const TetMesh& mesh,
-                                            const DeformableBodySettings& settings) {
+template <class BulletWorld>
+DeformableBody* DeformableWorldOf<BulletWorld>::AddTetBody(const TetMesh& mesh,
+                                                           const DeformableBodySettings& settings) {
   return AddTetBody(std::make_shared<const TetMesh>(mesh), settings);
 }
 
-DeformableBody* DeformableWorld::AddTetBody(std::shared_ptr<const TetMesh> mesh,
-                                            const DeformableBodySettings& settings) {
+template <class BulletWorld>
+DeformableBody* DeformableWorldOf<BulletWorld>::AddTetBody(std::shared_ptr<const TetMesh> mesh,
+                                                           const DeformableBodySettings& settings) {
   auto model = std::make_unique<TetElementModel>(std::move(mesh), settings.material);
   return AddDeformableBody(std::make_unique<DeformableBody>(std::move(model), settings));
 }
 
-DeformableBody* DeformableWorld::AddHexBody(const HexLattice& lattice,
-                                            const DeformableBodySettings& settings,
-                                            HexRotationMethod method) {
+template <class BulletWorld>
+DeformableBody* DeformableWorldOf<BulletWorld>::AddHexBody(const HexLattice& lattice,
+                                                           const DeformableBodySettings& settings,
+                                                           HexRotationMethod method) {
   return AddHexBody(std::make_shared<const HexLattice>(lattice), settings, method);
 }
 
-DeformableBody* DeformableWorld::AddHexBody(std::shared_ptr<const HexLattice> lattice,
-                                            const DeformableBodySettings& settings,
-                                            HexRotationMethod method) {
+template <class BulletWorld>
+DeformableBody* DeformableWorldOf<BulletWorld>::AddHexBody(
+    std::shared_ptr<const HexLattice> lattice, const DeformableBodySettings& settings,
+    HexRotationMethod method) {
   auto model = std::make_unique<HexElementModel>(std::move(lattice), settings.material, method);
   return AddDeformableBody(std::make_unique<DeformableBody>(std::move(model), settings));
 }
 
-DeformableBody* DeformableWorld::AddTetBody(const TetMesh& mesh,
-                                            const DeformableBodySettings& settings,
-                                            const btTransform& pose) {
+template <class BulletWorld>
+DeformableBody* DeformableWorldOf<BulletWorld>::AddTetBody(const TetMesh& mesh,
+                                                           const DeformableBodySettings& settings,
+                                                           const btTransform& pose) {
   return AddTetBody(std::make_shared<const TetMesh>(mesh), settings, pose);
 }
 
-DeformableBody* DeformableWorld::AddTetBody(std::shared_ptr<const TetMesh> mesh,
-                                            const DeformableBodySettings& settings,
-                                            const btTransform& pose) {
+template <class BulletWorld>
+DeformableBody* DeformableWorldOf<BulletWorld>::AddTetBody(std::shared_ptr<const TetMesh> mesh,
+                                                           const DeformableBodySettings& settings,
+                                                           const btTransform& pose) {
   auto body = std::make_unique<DeformableBody>(
       std::make_unique<TetElementModel>(std::move(mesh), settings.material), settings);
   PlaceAtPose(*body, pose);  // before the broadphase sees its bounds
   return AddDeformableBody(std::move(body));
 }
 
-DeformableBody* DeformableWorld::AddHexBody(const HexLattice& lattice,
-                                            const DeformableBodySettings& settings,
-                                            const btTransform& pose, HexRotationMethod method) {
+template <class BulletWorld>
+DeformableBody* DeformableWorldOf<BulletWorld>::AddHexBody(const HexLattice& lattice,
+                                                           const DeformableBodySettings& settings,
+                                                           const btTransform& pose,
+                                                           HexRotationMethod method) {
   return AddHexBody(std::make_shared<const HexLattice>(lattice), settings, pose, method);
 }
 
-DeformableBody* DeformableWorld::AddHexBody(std::shared_ptr<const HexLattice> lattice,
-                                            const DeformableBodySettings& settings,
-                                            const btTransform& pose, HexRotationMethod method) {
+template <class BulletWorld>
+DeformableBody* DeformableWorldOf<BulletWorld>::AddHexBody(
+    std::shared_ptr<const HexLattice> lattice, const DeformableBodySettings& settings,
+    const btTransform& pose, HexRotationMethod method) {
   auto body = std::make_unique<DeformableBody>(
       std::make_unique<HexElementModel>(std::move(lattice), settings.material, method), settings);
   PlaceAtPose(*body, pose);
   return AddDeformableBody(std::move(body));
 }
 
-DeformableBody* DeformableWorld::AddDeformableBody(std::unique_ptr<DeformableBody> body) {
+template <class BulletWorld>
+DeformableBody* DeformableWorldOf<BulletWorld>::AddDeformableBody(
+    std::unique_ptr<DeformableBody> body) {
   TAUT_DEMAND(body != nullptr, "AddDeformableBody: body is null");
   auto entry = std::make_unique<Entry>();
   entry->object = std::make_unique<DeformableCollisionObject>(std::move(body));
@@ -118,19 +133,22 @@ DeformableBody* DeformableWorld::AddDeformableBody(std::unique_ptr<DeformableBod
       added.settings().contact_margin, added.settings().restitution);
   entry->contacts->set_face_contact(added.settings().face_contact);
   bodies_.push_back(std::move(entry));
-  addCollisionObject(&bodies_.back()->collision_object(), btBroadphaseProxy::DefaultFilter,
-                     btBroadphaseProxy::AllFilter);
+  this->addCollisionObject(&bodies_.back()->collision_object(), btBroadphaseProxy::DefaultFilter,
+                           btBroadphaseProxy::AllFilter);
   return &bodies_.back()->body();
 }
 
-DeformableWorld::Entry& DeformableWorld::FindEntry(const DeformableBody* body) {
+template <class BulletWorld>
+typename DeformableWorldOf<BulletWorld>::Entry& DeformableWorldOf<BulletWorld>::FindEntry(
+    const DeformableBody* body) {
   for (auto& entry : bodies_)
     if (&entry->body() == body) return *entry;
   throw InputError("deformable body is not in this world");
 }
 
+template <class BulletWorld>
 template <typename T>
-T* DeformableWorld::ReplaceSource(DeformableBody* body, std::unique_ptr<T> source) {
+T* DeformableWorldOf<BulletWorld>::ReplaceSource(DeformableBody* body, std::unique_ptr<T> source) {
   auto& sources = FindEntry(body).sources;
   sources.erase(std::remove_if(sources.begin(), sources.end(),
                                [](const auto& s) { return dynamic_cast<T*>(s.get()) != nullptr; }),
@@ -140,39 +158,46 @@ T* DeformableWorld::ReplaceSource(DeformableBody* body, std::unique_ptr<T> sourc
   return result;
 }
 
-StrainLimitSource* DeformableWorld::SetStrainLimits(DeformableBody* body,
-                                                    const StrainLimitSettings& limits) {
+template <class BulletWorld>
+StrainLimitSource* DeformableWorldOf<BulletWorld>::SetStrainLimits(
+    DeformableBody* body, const StrainLimitSettings& limits) {
   FindEntry(body);  // names a foreign body before anything is built
   return ReplaceSource(body, std::make_unique<StrainLimitSource>(*body, limits, next_source_id_++));
 }
 
-EnergyLimitSource* DeformableWorld::SetEnergyLimits(DeformableBody* body,
-                                                    const EnergyLimitSettings& limits) {
+template <class BulletWorld>
+EnergyLimitSource* DeformableWorldOf<BulletWorld>::SetEnergyLimits(
+    DeformableBody* body, const EnergyLimitSettings& limits) {
   FindEntry(body);
   return ReplaceSource(body, std::make_unique<EnergyLimitSource>(*body, limits, next_source_id_++));
 }
 
-NodeHeightSource* DeformableWorld::SetNodeHeightLimit(DeformableBody* body, double z_min) {
+template <class BulletWorld>
+NodeHeightSource* DeformableWorldOf<BulletWorld>::SetNodeHeightLimit(DeformableBody* body,
+                                                                     double z_min) {
   FindEntry(body);
   return ReplaceSource(body, std::make_unique<NodeHeightSource>(
                                  *body, z_min, body->settings().contact_margin, next_source_id_++));
 }
 
-RigidIslandBody* DeformableWorld::FindRigidIslandBody(btRigidBody* rigid) {
+template <class BulletWorld>
+RigidIslandBody* DeformableWorldOf<BulletWorld>::FindRigidIslandBody(btRigidBody* rigid) {
   auto& slot = rigid_bodies_[rigid];
   if (slot == nullptr) slot = std::make_unique<RigidIslandBody>(rigid);
   return slot.get();
 }
 
-void DeformableWorld::AttachNodesToRigidBody(DeformableBody* body, const std::vector<int>& nodes,
-                                             const btRigidBody* rigid) {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::AttachNodesToRigidBody(DeformableBody* body,
+                                                            const std::vector<int>& nodes,
+                                                            const btRigidBody* rigid) {
   Entry& entry = FindEntry(body);
   TAUT_DEMAND(rigid != nullptr, "AttachNodesToRigidBody: rigid body is null");
   // The world's own (non-const) pointer to the rigid body.
   btRigidBody* owned = nullptr;
-  for (int i = 0; i < getNumCollisionObjects(); ++i)
-    if (getCollisionObjectArray()[i] == rigid)
-      owned = btRigidBody::upcast(getCollisionObjectArray()[i]);
+  for (int i = 0; i < this->getNumCollisionObjects(); ++i)
+    if (this->getCollisionObjectArray()[i] == rigid)
+      owned = btRigidBody::upcast(this->getCollisionObjectArray()[i]);
   TAUT_DEMAND(owned != nullptr, "body '", body->name(),
               "': AttachNodesToRigidBody: the rigid body is not in this world");
   const btTransform inverse = rigid->getWorldTransform().inverse();
@@ -191,7 +216,9 @@ void DeformableWorld::AttachNodesToRigidBody(DeformableBody* body, const std::ve
       *body, FindRigidIslandBody(owned), nodes, std::move(local), next_source_id_++));
 }
 
-void DeformableWorld::SetContactSurface(DeformableBody* body, const SurfaceMesh& surface) {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::SetContactSurface(DeformableBody* body,
+                                                       const SurfaceMesh& surface) {
   Entry& entry = FindEntry(body);
   ContactSurface embedded;
   try {
@@ -211,9 +238,13 @@ void DeformableWorld::SetContactSurface(DeformableBody* body, const SurfaceMesh&
                                                                    : std::next(it);
 }
 
-void DeformableWorld::ClearLimits(DeformableBody* body) { FindEntry(body).sources.clear(); }
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::ClearLimits(DeformableBody* body) {
+  FindEntry(body).sources.clear();
+}
 
-void DeformableWorld::SetThreadCount(int num_threads) {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::SetThreadCount(int num_threads) {
   TAUT_DEMAND(num_threads >= 1, "DeformableWorld::SetThreadCount: thread count must be >= 1, got ",
               num_threads);
   if (num_threads == thread_count()) return;
@@ -221,11 +252,12 @@ void DeformableWorld::SetThreadCount(int num_threads) {
   if (num_threads > 1) pool_ = std::make_unique<IslandThreadPool>(num_threads);
 }
 
-void DeformableWorld::RemoveDeformableBody(DeformableBody* body) {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::RemoveDeformableBody(DeformableBody* body) {
   auto it = std::find_if(bodies_.begin(), bodies_.end(),
                          [body](const auto& entry) { return &entry->body() == body; });
   TAUT_DEMAND(it != bodies_.end(), "RemoveDeformableBody: body is not in this world");
-  removeCollisionObject(&(*it)->collision_object());
+  this->removeCollisionObject(&(*it)->collision_object());
   forces_.Clear(forces_.h);  // they may name the body
   islands_solved_ = false;
   for (auto pair = pair_contacts_.begin(); pair != pair_contacts_.end();)
@@ -235,21 +267,23 @@ void DeformableWorld::RemoveDeformableBody(DeformableBody* body) {
   bodies_.erase(it);
 }
 
-int DeformableWorld::stepSimulation(btScalar time_step, int max_sub_steps,
-                                    btScalar fixed_time_step) {
+template <class BulletWorld>
+int DeformableWorldOf<BulletWorld>::stepSimulation(btScalar time_step, int max_sub_steps,
+                                                   btScalar fixed_time_step) {
   call_stats_ = StepStats();
   call_stats_.substeps = 0;
-  return btDiscreteDynamicsWorld::stepSimulation(time_step, max_sub_steps, fixed_time_step);
+  return BulletWorld::stepSimulation(time_step, max_sub_steps, fixed_time_step);
 }
 
-void DeformableWorld::internalSingleStepSimulation(btScalar h) {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::internalSingleStepSimulation(btScalar h) {
   if (bodies_.empty()) {
-    btDiscreteDynamicsWorld::internalSingleStepSimulation(h);
+    BulletWorld::internalSingleStepSimulation(h);
     call_stats_.substeps++;
     return;
   }
   const auto start = std::chrono::steady_clock::now();
-  btDiscreteDynamicsWorld::internalSingleStepSimulation(h);  // calls solveConstraints below
+  BulletWorld::internalSingleStepSimulation(h);  // calls solveConstraints below
   stats_.ms_total = MsSince(start);
   // From the stages' wall times: with several threads the islands' ms_rows and ms_solve are
   // summed over threads and may exceed the time their stage took.
@@ -260,7 +294,8 @@ void DeformableWorld::internalSingleStepSimulation(btScalar h) {
   AddSubstepStats(stats_, call_stats_);
 }
 
-void DeformableWorld::UpdateKinematicAttachments() {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::UpdateKinematicAttachments() {
   for (auto& entry : bodies_)
     for (const auto& attachment : entry->attachments)
       for (size_t k = 0; k < attachment.nodes.size(); ++k)
@@ -292,6 +327,31 @@ bool Overlaps(const Vec3& lo, const Vec3& hi, const btBroadphaseProxy& proxy) {
   return (lo.array() <= phi.array()).all() && (plo.array() <= hi.array()).all();
 }
 
+// Upper bound of the speed [m/s] of the points of a multibody link's collider: the speed of its
+// frame's origin plus its angular speed times the collider's bounding radius (the link's spatial
+// velocity from Bullet's last articulated-body pass).
+double EstimateLinkSpeed(const btMultiBodyLinkCollider& link) {
+  const btMultiBody* body = link.m_multiBody;
+  if (body == nullptr || link.isStaticOrKinematicObject()) return 0.0;
+  btVector3 linear = body->getBaseVel(), angular = body->getBaseOmega();
+  if (link.m_link >= 0) {
+    linear = body->getLink(link.m_link).m_absFrameTotVelocity.getLinear();
+    angular = body->getLink(link.m_link).m_absFrameTotVelocity.getAngular();
+  }
+  btVector3 center;
+  btScalar radius;
+  link.getCollisionShape()->getBoundingSphere(center, radius);
+  return static_cast<double>(linear.length() + angular.length() * (radius + center.length()));
+}
+
+// Keeps a multibody and its link colliders awake.
+void WakeMultiBody(btMultiBody& body) {
+  body.wakeUp();
+  if (body.getBaseCollider() != nullptr) body.getBaseCollider()->activate();
+  for (int l = 0; l < body.getNumLinks(); ++l)
+    if (body.getLinkCollider(l) != nullptr) body.getLinkCollider(l)->activate();
+}
+
 // Narrowphase set-up of a contact partner's shape, once per shape when a deformable first comes
 // near it: face planes of polyhedral shapes give exact inside distances (point_shape_distance.cc);
 // boxes have their own closed form. Not done when the shape is added to the world: face planes
@@ -304,7 +364,9 @@ void PrepareNarrowphaseShape(btCollisionShape& shape) {
 }
 }  // namespace
 
-void DeformableWorld::StepDeformables(double h, btContactSolverInfo& info, int& begun) {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::StepDeformables(double h, btContactSolverInfo& info,
+                                                     int& begun) {
   auto lap = std::chrono::steady_clock::now();
   BeginDeformableSteps(h, begun);  // 2. unconstrained deformable step
   stats_.ms_stage_begin_steps = LapMs(lap);
@@ -316,7 +378,10 @@ void DeformableWorld::StepDeformables(double h, btContactSolverInfo& info, int& 
   stats_.ms_stage_couple_rigid = LapMs(lap);
   GatherRowSources(info);  // 5. rows per island
   stats_.ms_stage_row_sources = LapMs(lap);
+  SuspendMotors();                    // 6. motors of coupled multibodies are island rows
   SolveRigidIslandsWithBullet(info);  // 6. rigid-only islands
+  ResumeMotors();
+  CoupleMultiBodies(h);  // 6. multibodies of deformable islands, from Bullet's answer
   stats_.ms_stage_bullet_solver = LapMs(lap);
   SolveIslands(h);  // 6. deformable islands
   stats_.ms_stage_solve_islands = LapMs(lap);
@@ -327,7 +392,8 @@ void DeformableWorld::StepDeformables(double h, btContactSolverInfo& info, int& 
   SumStageStats();  // 8. stats
 }
 
-void DeformableWorld::SumStageStats() {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::SumStageStats() {
   stats_.ms_unconstrained = stats_.ms_stage_begin_steps;
   stats_.ms_rows += stats_.ms_stage_partners + stats_.ms_stage_islands +
                     stats_.ms_stage_couple_rigid + stats_.ms_stage_row_sources;
@@ -335,9 +401,10 @@ void DeformableWorld::SumStageStats() {
   stats_.rigid_bodies_coupled = static_cast<int>(coupled_.size());
 }
 
-void DeformableWorld::BeginDeformableSteps(double h, int& begun) {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::BeginDeformableSteps(double h, int& begun) {
   UpdateKinematicAttachments();
-  const Vec3 gravity = ToEigen(getGravity());
+  const Vec3 gravity = ToEigen(this->getGravity());
   const int num_bodies = static_cast<int>(bodies_.size());
   if (pool_ != nullptr && num_bodies >= 2 && !IsCholmodAvailable()) {
     // Safe in parallel: a body's BeginStep writes only that body (state, element model, system
@@ -354,15 +421,19 @@ void DeformableWorld::BeginDeformableSteps(double h, int& begun) {
   }
 }
 
-void DeformableWorld::FindContactPartners(double h) {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::FindContactPartners(double h) {
   // Rigid partners may move too: each body's reach grows by the fastest rigid motion this step.
   double max_rigid_speed = 0.0;
-  const btCollisionObjectArray& objects = getCollisionObjectArray();
-  for (int i = 0; i < objects.size(); ++i)
+  const btCollisionObjectArray& objects = this->getCollisionObjectArray();
+  for (int i = 0; i < objects.size(); ++i) {
     if (IslandBuilder::IsDynamicRigidBody(*objects[i]))
       max_rigid_speed = std::max(
           max_rigid_speed,
           static_cast<double>(btRigidBody::upcast(objects[i])->getLinearVelocity().length()));
+    if (const auto* link = btMultiBodyLinkCollider::upcast(objects[i]))
+      max_rigid_speed = std::max(max_rigid_speed, EstimateLinkSpeed(*link));
+  }
   for (auto& entry : bodies_) {
     CalcSweptBounds(entry->body(), h, entry->body().settings().contact_margin, entry->swept_lo,
                     entry->swept_hi);
@@ -371,11 +442,12 @@ void DeformableWorld::FindContactPartners(double h) {
   FindDeformablePairs();
 }
 
-void DeformableWorld::FindRigidPartners(Entry& entry, double reach) {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::FindRigidPartners(Entry& entry, double reach) {
   entry.partners.clear();
   const Vec3 lo = entry.swept_lo.array() - reach;
   const Vec3 hi = entry.swept_hi.array() + reach;
-  btCollisionObjectArray& objects = getCollisionObjectArray();
+  btCollisionObjectArray& objects = this->getCollisionObjectArray();
   for (int i = 0; i < objects.size(); ++i) {
     btCollisionObject* object = objects[i];
     btCollisionShape* shape = object->getCollisionShape();
@@ -384,14 +456,19 @@ void DeformableWorld::FindRigidPartners(Entry& entry, double reach) {
     if (!ShouldCollide(entry.collision_object(), *object)) continue;  // groups and masks
     if (!Overlaps(lo, hi, *object->getBroadphaseHandle())) continue;
     PrepareNarrowphaseShape(*shape);
-    // Static, kinematic and dynamic rigid objects; the island body of a dynamic one is set in
-    // CoupleRigidBodies.
-    if (IslandBuilder::IsDynamicRigidBody(*object) || object->isStaticOrKinematicObject())
+    // Static, kinematic and dynamic rigid objects and multibody links; the island body of a
+    // dynamic one is set in CoupleRigidBodies, of a link's multibody in CoupleMultiBodies.
+    if (IslandBuilder::IsDynamicRigidBody(*object) || object->isStaticOrKinematicObject()) {
       entry.partners.push_back({object, nullptr});
+    } else if (const auto* link = btMultiBodyLinkCollider::upcast(object)) {
+      if (link->m_multiBody != nullptr)
+        entry.partners.push_back({object, nullptr, nullptr, link->m_link});
+    }
   }
 }
 
-void DeformableWorld::FindDeformablePairs() {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::FindDeformablePairs() {
   active_pairs_.clear();
   // The pair's source is kept across steps for its warm starts.
   auto activate = [this](int d, int e) {
@@ -419,7 +496,8 @@ void DeformableWorld::FindDeformablePairs() {
   }
 }
 
-std::unique_ptr<DeformableContactSource> DeformableWorld::MakePairContactSource(
+template <class BulletWorld>
+std::unique_ptr<DeformableContactSource> DeformableWorldOf<BulletWorld>::MakePairContactSource(
     const Entry& first, const Entry& second, int source_id) const {
   const DeformableBodySettings& a = first.object->body().settings();
   const DeformableBodySettings& b = second.object->body().settings();
@@ -432,14 +510,17 @@ std::unique_ptr<DeformableContactSource> DeformableWorld::MakePairContactSource(
       a.friction * b.friction, std::max(a.contact_margin, b.contact_margin));
 }
 
-void DeformableWorld::UniteIslands() {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::UniteIslands() {
   const int num_deformables = static_cast<int>(bodies_.size());
-  islands_.Reset(num_deformables, getCollisionObjectArray());
+  islands_.Reset(num_deformables, this->getCollisionObjectArray());
   for (int d = 0; d < num_deformables; ++d) {
     const Entry& entry = *bodies_[d];
     for (const ContactPartner& partner : entry.partners) {
       const int index = islands_.DynamicIndex(*partner.object);
       if (index >= 0) islands_.Unite(d, index);
+      const int multibody = islands_.MultiBodyIndex(*partner.object);
+      if (multibody >= 0) islands_.Unite(d, multibody);
     }
     for (const auto& attachment : entry.dynamic_attachments) {
       const int index = islands_.DynamicIndex(*attachment->rigid()->rigid());
@@ -447,7 +528,7 @@ void DeformableWorld::UniteIslands() {
     }
   }
   for (const DeformablePair& pair : active_pairs_) islands_.Unite(pair.first, pair.second);
-  islands_.UniteTouchingRigidBodies(*getDispatcher());
+  islands_.UniteTouchingRigidBodies(*this->getDispatcher());
   islands_.UniteJointedRigidBodies(*this);
   islands_.MakeDeformableIslands(next_source_id_);
   for (int d = 0; d < num_deformables; ++d) {
@@ -457,7 +538,8 @@ void DeformableWorld::UniteIslands() {
   }
 }
 
-void DeformableWorld::CoupleRigidBodies(double h) {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::CoupleRigidBodies(double h) {
   coupled_.clear();
   const int first_dynamic = static_cast<int>(bodies_.size());
   for (int k = 0; k < islands_.num_dynamic_bodies(); ++k) {
@@ -477,7 +559,78 @@ void DeformableWorld::CoupleRigidBodies(double h) {
     }
 }
 
-RigidIslandBody* DeformableWorld::FindCoupledBody(const btCollisionObject& object, int& island) {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::CoupleMultiBodies(double h) {
+  // After Bullet's solve: v* is the velocity Bullet's multibody solver left (its joint motors,
+  // limits and contacts with rigid objects), and W = M^-1 uses its articulated-body pass.
+  for (int k = 0; k < islands_.num_multibodies(); ++k) {
+    const int index = islands_.multibody_index(k);
+    const int island = islands_.IslandOf(index);
+    if (island < 0) continue;  // touches no deformable: Bullet's alone
+    MultiBodyIslandBody* body = FindMultiBodyIslandBody(islands_.multibody(index));
+    WakeMultiBody(*body->multibody());  // Bullet's sleeping test does not see deformable contacts
+    body->BeginStep(h);
+    coupled_multibodies_.push_back(body);
+    islands_.island(island).bodies.push_back(body);
+  }
+  for (auto& entry : bodies_) {
+    bool linked = false;
+    for (ContactPartner& partner : entry->partners) {
+      const int index = islands_.MultiBodyIndex(*partner.object);
+      if (index < 0) continue;
+      partner.multibody = FindMultiBodyIslandBody(islands_.multibody(index));
+      linked = true;
+    }
+    // The contact source took its copy of the partners in GatherRowSources.
+    if (linked) entry->contacts->set_partners(entry->partners);
+  }
+}
+
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::GatherMultiBodyMotors() {
+  suspended_motors_.clear();
+  if constexpr (std::is_base_of_v<btMultiBodyDynamicsWorld, BulletWorld>) {
+    for (auto& source : motor_sources_)
+      if (source != nullptr) source->Clear();
+    for (int c = 0; c < this->getNumMultiBodyConstraints(); ++c) {
+      auto* motor = dynamic_cast<btMultiBodyJointMotor*>(this->getMultiBodyConstraint(c));
+      if (motor == nullptr || motor->getMaxAppliedImpulse() == btScalar(0)) continue;
+      const int index = islands_.FindMultiBodyIndex(motor->getMultiBodyA());
+      const int island = index >= 0 ? islands_.IslandOf(index) : -1;
+      if (island < 0) continue;  // Bullet's alone
+      if (static_cast<int>(motor_sources_.size()) <= island) motor_sources_.resize(island + 1);
+      auto& source = motor_sources_[island];
+      if (source == nullptr) source = std::make_unique<MultiBodyMotorSource>(next_source_id_++);
+      source->AddMotor(*motor, FindMultiBodyIslandBody(motor->getMultiBodyA()), c);
+      suspended_motors_.push_back({motor, motor->getMaxAppliedImpulse()});
+    }
+    for (size_t i = 0; i < motor_sources_.size() && static_cast<int>(i) < islands_.num_islands();
+         ++i)
+      if (motor_sources_[i] != nullptr && motor_sources_[i]->num_motors() > 0)
+        islands_.island(static_cast<int>(i)).sources.push_back(motor_sources_[i].get());
+  }
+}
+
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::SuspendMotors() {
+  for (auto& [motor, impulse] : suspended_motors_) motor->setMaxAppliedImpulse(btScalar(0));
+}
+
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::ResumeMotors() {
+  for (auto& [motor, impulse] : suspended_motors_) motor->setMaxAppliedImpulse(impulse);
+}
+
+template <class BulletWorld>
+MultiBodyIslandBody* DeformableWorldOf<BulletWorld>::FindMultiBodyIslandBody(btMultiBody* body) {
+  auto& slot = multibody_bodies_[body];
+  if (slot == nullptr) slot = std::make_unique<MultiBodyIslandBody>(body);
+  return slot.get();
+}
+
+template <class BulletWorld>
+RigidIslandBody* DeformableWorldOf<BulletWorld>::FindCoupledBody(const btCollisionObject& object,
+                                                                 int& island) {
   const int index = islands_.DynamicIndex(object);
   if (index < 0) return nullptr;
   const int coupled_island = islands_.IslandOf(index);
@@ -486,7 +639,8 @@ RigidIslandBody* DeformableWorld::FindCoupledBody(const btCollisionObject& objec
   return FindRigidIslandBody(islands_.dynamic_body(index));
 }
 
-void DeformableWorld::GatherRowSources(const btContactSolverInfo& info) {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::GatherRowSources(const btContactSolverInfo& info) {
   AddCoupledManifoldsAndJoints(info);
   for (auto& entry : bodies_) {
     Island& island = islands_.island(entry->island);
@@ -500,6 +654,7 @@ void DeformableWorld::GatherRowSources(const btContactSolverInfo& info) {
   }
   for (const DeformablePair& pair : active_pairs_)
     islands_.island(bodies_[pair.first]->island).sources.push_back(pair.source);
+  GatherMultiBodyMotors();
   for (int i = 0; i < islands_.num_islands(); ++i) {
     Island& island = islands_.island(i);
     if (island.manifolds->num_points() > 0) island.sources.push_back(island.manifolds.get());
@@ -507,8 +662,9 @@ void DeformableWorld::GatherRowSources(const btContactSolverInfo& info) {
   }
 }
 
-void DeformableWorld::AddCoupledManifoldsAndJoints(const btContactSolverInfo& info) {
-  btDispatcher* dispatcher = getDispatcher();
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::AddCoupledManifoldsAndJoints(const btContactSolverInfo& info) {
+  btDispatcher* dispatcher = this->getDispatcher();
   for (int m = 0; m < dispatcher->getNumManifolds(); ++m) {
     const btPersistentManifold* manifold = dispatcher->getManifoldByIndexInternal(m);
     if (manifold->getNumContacts() == 0) continue;
@@ -517,8 +673,8 @@ void DeformableWorld::AddCoupledManifoldsAndJoints(const btContactSolverInfo& in
     const RigidIslandBody* b = FindCoupledBody(*manifold->getBody1(), island);
     if (island >= 0) islands_.island(island).manifolds->AddManifold(*manifold, a, b, info);
   }
-  for (int j = 0; j < getNumConstraints(); ++j) {
-    btTypedConstraint* joint = getConstraint(j);
+  for (int j = 0; j < this->getNumConstraints(); ++j) {
+    btTypedConstraint* joint = this->getConstraint(j);
     int island = -1;
     const RigidIslandBody* a = FindCoupledBody(joint->getRigidBodyA(), island);
     const RigidIslandBody* b = FindCoupledBody(joint->getRigidBodyB(), island);
@@ -526,7 +682,8 @@ void DeformableWorld::AddCoupledManifoldsAndJoints(const btContactSolverInfo& in
   }
 }
 
-void DeformableWorld::SolveRigidIslandsWithBullet(btContactSolverInfo& info) {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::SolveRigidIslandsWithBullet(btContactSolverInfo& info) {
   // Bullet's solver runs on every rigid body, the coupled ones too, although their answer is
   // replaced (EndSteps restores their transform and writes the island's velocity). Its pass over
   // them must stay: it is what breaks a joint whose impulse exceeds its breaking threshold
@@ -535,7 +692,7 @@ void DeformableWorld::SolveRigidIslandsWithBullet(btContactSolverInfo& info) {
   // the bodies are back in a rigid-only island and which users read. Leaving the coupled bodies
   // out (an island callback that skips them) keeps the determinism pins, but a breakable joint on
   // a box resting on a soft block then never breaks, and the run diverges.
-  btDiscreteDynamicsWorld::solveConstraints(info);
+  BulletWorld::solveConstraints(info);
 }
 
 namespace {
@@ -550,7 +707,8 @@ bool HasGImpactShape(const btCollisionShape& shape) {
 }
 }  // namespace
 
-bool DeformableWorld::CanSolveIslandsInParallel() const {
+template <class BulletWorld>
+bool DeformableWorldOf<BulletWorld>::CanSolveIslandsInParallel() const {
   if (pool_ == nullptr || solved_islands_.size() < 2) return false;
   for (const auto& entry : bodies_) {
     if (entry->object->body().system().uses_cholmod()) return false;  // see BeginDeformableSteps
@@ -560,7 +718,8 @@ bool DeformableWorld::CanSolveIslandsInParallel() const {
   return true;
 }
 
-void DeformableWorld::SolveIslands(double h) {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::SolveIslands(double h) {
   solved_islands_.clear();
   for (int i = 0; i < islands_.num_islands(); ++i)
     if (!islands_.island(i).sources.empty()) solved_islands_.push_back(i);
@@ -599,18 +758,21 @@ void DeformableWorld::SolveIslands(double h) {
   merge_stats();
 }
 
-void DeformableWorld::EndSteps(double h) {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::EndSteps(double h) {
   for (auto& entry : bodies_) entry->body().EndStep(h);
   for (RigidIslandBody* rigid : coupled_) rigid->EndStep();
+  for (MultiBodyIslandBody* multibody : coupled_multibodies_) multibody->EndStep();
 }
 
-void DeformableWorld::ReportForces() {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::ReportForces() {
   for (int i = 0; i < islands_.num_islands(); ++i) {
     const Island& island = islands_.island(i);
     if (island.sources.empty()) continue;  // not solved this substep
     const IslandSolver& solver = bodies_[island.first_deformable]->solver;
     AppendIslandForces(island.bodies, solver.last_rows(), solver.last_multipliers(),
-                       getCollisionObjectArray(), forces_);
+                       this->getCollisionObjectArray(), forces_);
   }
 }
 
@@ -625,7 +787,9 @@ std::vector<Entry> SelectBodyEntries(const std::vector<Entry>& all, const Deform
 }
 }  // namespace
 
-std::vector<DeformableWorld::SolvedIsland> DeformableWorld::last_solved_islands() const {
+template <class BulletWorld>
+std::vector<typename DeformableWorldOf<BulletWorld>::SolvedIsland>
+DeformableWorldOf<BulletWorld>::last_solved_islands() const {
   std::vector<SolvedIsland> solved;
   if (!islands_solved_) return solved;
   for (int i = 0; i < islands_.num_islands(); ++i) {
@@ -637,46 +801,52 @@ std::vector<DeformableWorld::SolvedIsland> DeformableWorld::last_solved_islands(
   return solved;
 }
 
-std::vector<int> DeformableWorld::driven_nodes(const DeformableBody* body,
-                                               const btRigidBody* rigid) const {
+template <class BulletWorld>
+std::vector<int> DeformableWorldOf<BulletWorld>::driven_nodes(const DeformableBody* body,
+                                                              const btRigidBody* rigid) const {
   TAUT_DEMAND(HasBody(body), "driven_nodes: deformable body is not in this world");
   std::vector<int> nodes;
   for (const auto& entry : bodies_) {
     if (&entry->object->body() != body) continue;
-    for (const Entry::Attachment& attachment : entry->attachments)
+    for (const typename Entry::Attachment& attachment : entry->attachments)
       if (attachment.rigid == rigid)
         nodes.insert(nodes.end(), attachment.nodes.begin(), attachment.nodes.end());
   }
   return nodes;
 }
 
-std::vector<DeformableContactPoint> DeformableWorld::last_contacts(
+template <class BulletWorld>
+std::vector<DeformableContactPoint> DeformableWorldOf<BulletWorld>::last_contacts(
     const DeformableBody* body) const {
   TAUT_DEMAND(HasBody(body), "last_contacts: deformable body is not in this world");
   return SelectBodyEntries(forces_.contacts, body);
 }
 
-std::vector<LimitRowMultiplier> DeformableWorld::last_limit_multipliers(
+template <class BulletWorld>
+std::vector<LimitRowMultiplier> DeformableWorldOf<BulletWorld>::last_limit_multipliers(
     const DeformableBody* body) const {
   TAUT_DEMAND(HasBody(body), "last_limit_multipliers: deformable body is not in this world");
   return SelectBodyEntries(forces_.limits, body);
 }
 
-bool DeformableWorld::HasBody(const DeformableBody* body) const {
+template <class BulletWorld>
+bool DeformableWorldOf<BulletWorld>::HasBody(const DeformableBody* body) const {
   return std::any_of(bodies_.begin(), bodies_.end(),
                      [body](const auto& entry) { return &entry->object->body() == body; });
 }
 
-void DeformableWorld::solveConstraints(btContactSolverInfo& info) {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::solveConstraints(btContactSolverInfo& info) {
   const double h = static_cast<double>(info.m_timeStep);
   forces_.Clear(h);
   islands_solved_ = false;
   if (bodies_.empty()) {
-    btDiscreteDynamicsWorld::solveConstraints(info);
+    BulletWorld::solveConstraints(info);
     return;
   }
   stats_ = StepStats();
   coupled_.clear();
+  coupled_multibodies_.clear();
   int begun = 0;
   try {
     StepDeformables(h, info, begun);
@@ -685,9 +855,13 @@ void DeformableWorld::solveConstraints(btContactSolverInfo& info) {
     // the world stays consistent at the last good state.
     for (int b = 0; b < begun; ++b) bodies_[b]->body().AbortStep();
     for (RigidIslandBody* rigid : coupled_) rigid->AbortStep();
+    for (MultiBodyIslandBody* multibody : coupled_multibodies_) multibody->AbortStep();
     forces_.Clear(h);
     throw;
   }
 }
+
+template class DeformableWorldOf<btDiscreteDynamicsWorld>;
+template class DeformableWorldOf<btMultiBodyDynamicsWorld>;
 
 }  // namespace taut

@@ -3,6 +3,8 @@
 
 #include <BulletCollision/CollisionDispatch/btEmptyCollisionAlgorithm.h>
 #include <BulletDynamics/Dynamics/btDiscreteDynamicsWorld.h>
+#include <BulletDynamics/Featherstone/btMultiBodyConstraintSolver.h>
+#include <BulletDynamics/Featherstone/btMultiBodyDynamicsWorld.h>
 
 #include <map>
 #include <memory>
@@ -14,6 +16,8 @@
 #include "bullet_bridge/island_builder.h"
 #include "bullet_bridge/island_thread_pool.h"
 #include "bullet_bridge/joint_source.h"
+#include "bullet_bridge/multibody_island_body.h"
+#include "bullet_bridge/multibody_motor_source.h"
 #include "bullet_bridge/node_attachment_source.h"
 #include "bullet_bridge/rigid_contact_source.h"
 #include "bullet_bridge/rigid_island_body.h"
@@ -31,6 +35,16 @@
 
 namespace taut {
 
+// The constraint solver a Bullet world class is built with.
+template <class BulletWorld>
+struct WorldSolverOf {
+  using type = btConstraintSolver;
+};
+template <>
+struct WorldSolverOf<btMultiBodyDynamicsWorld> {
+  using type = btMultiBodyConstraintSolver;
+};
+
 // Drop-in replacement for btDiscreteDynamicsWorld. Deformable bodies live in Bullet's broadphase
 // as btCollisionObjects (AABBs refreshed every substep) and are stepped inside stepSimulation's
 // fixed substeps together with the rigid bodies. Islands (docs/architecture.md §4) join each
@@ -40,11 +54,19 @@ namespace taut {
 // contacts of the island, solved by one PGS. Rigid islands without deformables go to Bullet's
 // own solver untouched; without deformable bodies every substep is exactly
 // btDiscreteDynamicsWorld's.
-class DeformableWorld : public btDiscreteDynamicsWorld {
+//
+// BulletWorld is btDiscreteDynamicsWorld (DeformableWorld) or btMultiBodyDynamicsWorld
+// (DeformableMultiBodyWorld, below): there a btMultiBody whose link collider touches a deformable
+// joins its island as a MultiBodyIslandBody with its joint motors as rows (two-way coupling,
+// docs/architecture.md §4); without deformables every substep is exactly the Bullet world's.
+template <class BulletWorld>
+class DeformableWorldOf : public BulletWorld {
  public:
-  DeformableWorld(btDispatcher* dispatcher, btBroadphaseInterface* broadphase,
-                  btConstraintSolver* solver, btCollisionConfiguration* configuration);
-  ~DeformableWorld() override;
+  // The constraint solver type BulletWorld takes (btMultiBodyConstraintSolver for multibodies).
+  using Solver = typename WorldSolverOf<BulletWorld>::type;
+  DeformableWorldOf(btDispatcher* dispatcher, btBroadphaseInterface* broadphase, Solver* solver,
+                    btCollisionConfiguration* configuration);
+  ~DeformableWorldOf() override;
 
   // Makes a co-rotational tet body from a mesh (validated; throws InputError) and adds it.
   // The world owns the body; the pointer stays valid until RemoveDeformableBody.
@@ -169,7 +191,8 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   // State snapshots (bullet_bridge/world_snapshot.h), between stepSimulation calls: everything
   // the next step depends on (deformables, warm starts, rigid bodies, joints, Bullet's contact
   // manifolds, the substep clock, the last step's statistics and forces), so a restored world
-  // continues bit-identically to the one it was saved from. A snapshot fits this world and any
+  // continues bit-identically to the one it was saved from (in a DeformableMultiBodyWorld the
+  // multibodies' state is not part of it). A snapshot fits this world and any
   // world built the same way (same bodies, objects and joints in the same order).
   WorldSnapshot SaveSnapshot() const;
   // Throws InputError saying what does not match, and changes nothing, when the snapshot is of a
@@ -250,6 +273,17 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   void SumStageStats();
   // Drives nodes attached to static/kinematic rigid bodies to their current anchors.
   void UpdateKinematicAttachments();
+  // Stage 6, after Bullet's solve: multibodies whose links touch a deformable begin their step
+  // from Bullet's answer and join their island; contact partners get their island bodies.
+  void CoupleMultiBodies(double h);
+  // Stage 5 (multibody worlds): the joint motors of the multibodies in deformable islands become
+  // island rows (MultiBodyMotorSource); Bullet's solver skips them this step (SuspendMotors).
+  void GatherMultiBodyMotors();
+  // Sets the max impulse of the gathered motors to 0 for Bullet's solve, and back.
+  void SuspendMotors();
+  void ResumeMotors();
+  // The island body of a multibody (made on first use).
+  MultiBodyIslandBody* FindMultiBodyIslandBody(btMultiBody* body);
   // The island body of the dynamic rigid body `object` when it is in a deformable island (then
   // `island` is set to that island), else null.
   RigidIslandBody* FindCoupledBody(const btCollisionObject& object, int& island);
@@ -281,6 +315,12 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   std::vector<DeformablePair> active_pairs_;
   IslandBuilder islands_;                  // this step's islands
   std::vector<RigidIslandBody*> coupled_;  // rigid bodies in deformable islands, this step
+  std::unordered_map<const btMultiBody*, std::unique_ptr<MultiBodyIslandBody>> multibody_bodies_;
+  std::vector<MultiBodyIslandBody*> coupled_multibodies_;  // multibodies in them, this step
+  // Motor sources by island slot (made when an island first has motors), and this step's motors
+  // with their max impulses while Bullet's solver runs.
+  std::vector<std::unique_ptr<MultiBodyMotorSource>> motor_sources_;
+  std::vector<std::pair<btMultiBodyJointMotor*, btScalar>> suspended_motors_;
   SqpSettings solver_settings_;
   std::unique_ptr<IslandThreadPool> pool_;  // null: one thread (SetThreadCount)
   // This step's islands with rows, each one's statistics and whether its solve returned; kept
@@ -297,5 +337,14 @@ class DeformableWorld : public btDiscreteDynamicsWorld {
   // islands_ hold the last substep's solved islands (last_solved_islands).
   bool islands_solved_ = false;
 };
+
+// Instantiated in deformable_world.cc (and world_snapshot.cc for the snapshot members).
+extern template class DeformableWorldOf<btDiscreteDynamicsWorld>;
+extern template class DeformableWorldOf<btMultiBodyDynamicsWorld>;
+
+// The world of rigid bodies and deformables.
+using DeformableWorld = DeformableWorldOf<btDiscreteDynamicsWorld>;
+// The world of rigid bodies, btMultiBodies and deformables.
+using DeformableMultiBodyWorld = DeformableWorldOf<btMultiBodyDynamicsWorld>;
 
 }  // namespace taut

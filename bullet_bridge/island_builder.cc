@@ -2,6 +2,9 @@
 
 #include <BulletCollision/BroadphaseCollision/btDispatcher.h>
 #include <BulletCollision/NarrowPhaseCollision/btPersistentManifold.h>
+#include <BulletDynamics/Featherstone/btMultiBodyLinkCollider.h>
+
+#include <algorithm>
 
 #include "bullet_bridge/deformable_collision_object.h"
 
@@ -22,8 +25,35 @@ void IslandBuilder::Reset(int num_deformables, const btCollisionObjectArray& obj
     dynamic_index_[i] = num_deformables + static_cast<int>(dynamic_.size());
     dynamic_.push_back(btRigidBody::upcast(objects[i]));
   }
-  union_find_.Reset(num_deformables + static_cast<int>(dynamic_.size()));
+  NumberMultiBodies(objects);
+  union_find_.Reset(first_multibody_ + static_cast<int>(multibodies_.size()));
   num_islands_ = 0;
+}
+
+void IslandBuilder::NumberMultiBodies(const btCollisionObjectArray& objects) {
+  first_multibody_ = num_deformables_ + static_cast<int>(dynamic_.size());
+  multibodies_.clear();
+  multibody_index_.assign(objects.size(), -1);
+  for (int i = 0; i < objects.size(); ++i) {
+    const btMultiBodyLinkCollider* link = btMultiBodyLinkCollider::upcast(objects[i]);
+    if (link == nullptr || link->m_multiBody == nullptr || link->isStaticOrKinematicObject())
+      continue;
+    auto found = std::find(multibodies_.begin(), multibodies_.end(), link->m_multiBody);
+    multibody_index_[i] = first_multibody_ + static_cast<int>(found - multibodies_.begin());
+    if (found == multibodies_.end()) multibodies_.push_back(link->m_multiBody);
+  }
+}
+
+int IslandBuilder::FindMultiBodyIndex(const btMultiBody* body) const {
+  const auto found = std::find(multibodies_.begin(), multibodies_.end(), body);
+  return found == multibodies_.end()
+             ? -1
+             : first_multibody_ + static_cast<int>(found - multibodies_.begin());
+}
+
+int IslandBuilder::MultiBodyIndex(const btCollisionObject& object) const {
+  const int i = object.getWorldArrayIndex();
+  return i >= 0 && i < static_cast<int>(multibody_index_.size()) ? multibody_index_[i] : -1;
 }
 
 int IslandBuilder::DynamicIndex(const btCollisionObject& object) const {

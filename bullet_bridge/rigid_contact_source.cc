@@ -73,6 +73,9 @@ void RigidContactSource::set_objects(const std::vector<const btCollisionObject*>
 
 btTransform RigidContactSource::CalcPartnerTransform(const IslandIterate& iterate, size_t o) const {
   const ContactPartner& partner = partners_[o];
+  if (partner.multibody != nullptr)
+    return partner.multibody->PredictColliderTransform(
+        partner.link, iterate.h(), iterate.v(iterate.IndexOf(partner.multibody)));
   if (partner.rigid == nullptr) return partner.object->getWorldTransform();
   return partner.rigid->PredictTransform(iterate.h(), iterate.v(iterate.IndexOf(partner.rigid)));
 }
@@ -84,6 +87,9 @@ RigidContactSource::PartnerRows RigidContactSource::MakePartnerRows(const Island
   PartnerRows rows;
   rows.body_index = iterate.IndexOf(&body_);
   rows.rigid_index = partner.rigid != nullptr ? iterate.IndexOf(partner.rigid) : -1;
+  rows.multibody = partner.multibody;
+  rows.link = partner.link;
+  if (partner.multibody != nullptr) rows.rigid_index = iterate.IndexOf(partner.multibody);
   // Stable partner id for warm starting: the object's index in the world, or for an object in
   // no world (index -1, e.g. given to set_objects) its position among the partners.
   rows.outside_world = object.getWorldArrayIndex() < 0;
@@ -94,8 +100,8 @@ RigidContactSource::PartnerRows RigidContactSource::MakePartnerRows(const Island
 }
 
 void RigidContactSource::FillRow(const PartnerRows& partner, const ContactPoint& point,
-                                 std::uint64_t key, const Vec3& d, const Vec3& r, int k,
-                                 ConstraintRow& row) const {
+                                 std::uint64_t key, const Vec3& d, const Vec3& q, const Vec3& com,
+                                 int k, ConstraintRow& row) const {
   row.key = key;
   row.body = partner.body_index;
   row.type = RowType::kContact;
@@ -106,7 +112,14 @@ void RigidContactSource::FillRow(const PartnerRows& partner, const ContactPoint&
   }
   row.friction_of = k;
   row.mu = partner.mu;
-  if (partner.rigid_index >= 0) {
+  if (partner.multibody != nullptr) {
+    // The link's surface point q moves with J_q qdot: its side is -d^T J_q (the multibody's
+    // contact Jacobian, btMultiBody::fillContactJacobianMultiDof).
+    row.body2 = partner.rigid_index;
+    row.num_nodes2 = partner.multibody->FillPointRowEntries(partner.link, q, d, -1.0,
+                                                            row.nodes2.data(), row.J2.data());
+  } else if (partner.rigid_index >= 0) {
+    const Vec3 r = q - com;
     row.body2 = partner.rigid_index;
     row.num_nodes2 = 2;
     row.nodes2[0] = 0;
@@ -147,7 +160,7 @@ void RigidContactSource::AppendContactRows(const IslandIterate& iterate, const P
     ConstraintRow& row = rows.emplace_back();
     const std::uint64_t key =
         key_.Pack(index, partner.outside_world, partner.object_id, row_offset + k);
-    FillRow(partner, point, key, d[k], q - com, k, row);
+    FillRow(partner, point, key, d[k], q, com, k, row);
     row.C = k == 0 ? gap : 0.0;
   }
   if (partner.restitution > 0.0)
@@ -283,9 +296,10 @@ double RigidContactSource::CalcPointGap(const IslandIterate& iterate, size_t i,
       // The normal row AppendIslandRows emits for this contact, for its restitution C.
       const PartnerRows partner = MakePartnerRows(iterate, o);
       ConstraintRow normal;
-      const Vec3 r = p - contact.gap * contact.normal - ToEigen(transform.getOrigin());
+      const Vec3 q = p - contact.gap * contact.normal;
       const std::uint64_t key = key_.Pack(i, partner.outside_world, partner.object_id, 0);
-      FillRow(partner, points_[i], key, contact.normal, r, 0, normal);
+      FillRow(partner, points_[i], key, contact.normal, q, ToEigen(transform.getOrigin()), 0,
+              normal);
       c = CalcRestitutionC(iterate, normal, contact.gap, e);
     }
     gap = std::min(gap, c);

@@ -1,13 +1,15 @@
 // Contacts of a deformable body's boundary nodes with Bullet rigid objects, as SQP rows: normal
 // C = gap >= 0 and two Coulomb friction rows on the disk (docs/math.md §5.5). Static and kinematic
-// objects are immovable during the step (one-sided rows); dynamic rigid bodies of the island
-// take the reaction (two-sided rows: the node against the body's surface point).
+// objects are immovable during the step (one-sided rows); dynamic rigid bodies and the links of
+// btMultiBodies in the island take the reaction (two-sided rows: the node against the body's
+// surface point; a link's side acts on its multibody's generalized velocity).
 #pragma once
 
 #include <BulletCollision/CollisionDispatch/btCollisionObject.h>
 
 #include <vector>
 
+#include "bullet_bridge/multibody_island_body.h"
 #include "bullet_bridge/rigid_island_body.h"
 #include "constraints/constraint_row.h"
 #include "constraints/row_key_layouts.h"
@@ -19,6 +21,9 @@ namespace taut {
 struct ContactPartner {
   const btCollisionObject* object = nullptr;
   const RigidIslandBody* rigid = nullptr;  // island body of a dynamic rigid body, else null
+  // Island body of the multibody whose link collider `object` is (link -1: its base), else null.
+  const MultiBodyIslandBody* multibody = nullptr;
+  int link = -1;
 };
 
 class RigidContactSource final : public ConstraintSource {
@@ -66,8 +71,10 @@ class RigidContactSource final : public ConstraintSource {
   double CalcPointGap(const IslandIterate& iterate, size_t i, const Vec3& p) const;
   // What the rows against one partner share at an iterate.
   struct PartnerRows {
-    int body_index;      // the deformable's island index
-    int rigid_index;     // the partner's island index, -1 when immovable
+    int body_index;                        // the deformable's island index
+    int rigid_index;                       // the partner's island index, -1 when immovable
+    const MultiBodyIslandBody* multibody;  // a multibody link partner (its island index in
+    int link;                              // rigid_index), else null
     bool outside_world;  // key fields: the object in no world, keyed by its partner position
     int object_id;
     double mu;           // combined friction
@@ -76,9 +83,9 @@ class RigidContactSource final : public ConstraintSource {
   // Partner o's shared row data at the iterate.
   PartnerRows MakePartnerRows(const IslandIterate& iterate, size_t o) const;
   // The row of direction d (k = 0 normal, 1-2 friction tangents) of `point` (row key `key`)
-  // against a partner whose surface point is its centre of mass + r.
+  // against a partner whose surface point is q (its centre of mass or frame origin at com).
   void FillRow(const PartnerRows& partner, const ContactPoint& point, std::uint64_t key,
-               const Vec3& d, const Vec3& r, int k, ConstraintRow& row) const;
+               const Vec3& d, const Vec3& q, const Vec3& com, int k, ConstraintRow& row) const;
   // The normal and two friction rows of a contact of `point` (gap, unit normal n from the
   // partner toward the body, partner's surface point q), keyed by `index` and `row_offset`.
   void AppendContactRows(const IslandIterate& iterate, const PartnerRows& partner,

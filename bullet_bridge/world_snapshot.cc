@@ -14,20 +14,22 @@ bool SnapshotSkip(const char* part) {
 }
 
 // The stages of a snapshot, with access to the world's entries.
-struct DeformableWorld::Snapshots {
+template <class BulletWorld>
+struct DeformableWorldOf<BulletWorld>::Snapshots {
   // Each body's state and its solver's warm starts.
-  static void SaveDeformables(const DeformableWorld& world, WorldSnapshot& snapshot);
+  static void SaveDeformables(const DeformableWorldOf& world, WorldSnapshot& snapshot);
   // The row-key source ids the world hands out as it steps: deformable pairs and island slots.
-  static void SaveSourceIds(const DeformableWorld& world, WorldSnapshot& snapshot);
+  static void SaveSourceIds(const DeformableWorldOf& world, WorldSnapshot& snapshot);
   // Forces out with pointers as indices.
-  static void SaveForces(const DeformableWorld& world, WorldSnapshot& snapshot);
+  static void SaveForces(const DeformableWorldOf& world, WorldSnapshot& snapshot);
   // Throws InputError unless the snapshot's deformables fit the world's.
-  static void CheckDeformables(const DeformableWorld& world, const WorldSnapshot& snapshot);
-  static void RestoreDeformables(DeformableWorld& world, const WorldSnapshot& snapshot);
-  static void RestoreSourceIds(DeformableWorld& world, const WorldSnapshot& snapshot);
-  static void RestoreForces(DeformableWorld& world, const WorldSnapshot& snapshot);
+  static void CheckDeformables(const DeformableWorldOf& world, const WorldSnapshot& snapshot);
+  static void RestoreDeformables(DeformableWorldOf& world, const WorldSnapshot& snapshot);
+  static void RestoreSourceIds(DeformableWorldOf& world, const WorldSnapshot& snapshot);
+  static void RestoreForces(DeformableWorldOf& world, const WorldSnapshot& snapshot);
   // The id counter after a restore (see the definition).
-  static int CalcRestoredNextSourceId(const DeformableWorld& world, const WorldSnapshot& snapshot);
+  static int CalcRestoredNextSourceId(const DeformableWorldOf& world,
+                                      const WorldSnapshot& snapshot);
 };
 
 namespace {
@@ -51,8 +53,9 @@ int CountFreeNodes(const std::vector<NodeKind>& kinds) {
 }
 }  // namespace
 
-void DeformableWorld::Snapshots::SaveDeformables(const DeformableWorld& world,
-                                                 WorldSnapshot& snapshot) {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::Snapshots::SaveDeformables(const DeformableWorldOf& world,
+                                                                WorldSnapshot& snapshot) {
   for (const auto& entry : world.bodies_) {
     const DeformableBody& body = entry->object->body();
     snapshot.deformables.push_back(
@@ -60,8 +63,9 @@ void DeformableWorld::Snapshots::SaveDeformables(const DeformableWorld& world,
   }
 }
 
-void DeformableWorld::Snapshots::SaveSourceIds(const DeformableWorld& world,
-                                               WorldSnapshot& snapshot) {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::Snapshots::SaveSourceIds(const DeformableWorldOf& world,
+                                                              WorldSnapshot& snapshot) {
   std::vector<const Entry*> entries;
   for (const auto& entry : world.bodies_) entries.push_back(entry.get());
   const auto index = IndexByPointer(entries);
@@ -72,7 +76,9 @@ void DeformableWorld::Snapshots::SaveSourceIds(const DeformableWorld& world,
   snapshot.next_source_id = world.next_source_id_;
 }
 
-void DeformableWorld::Snapshots::SaveForces(const DeformableWorld& world, WorldSnapshot& snapshot) {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::Snapshots::SaveForces(const DeformableWorldOf& world,
+                                                           WorldSnapshot& snapshot) {
   std::vector<const DeformableBody*> bodies;
   for (const auto& entry : world.bodies_) bodies.push_back(&entry->object->body());
   std::vector<const btCollisionObject*> objects;
@@ -100,8 +106,9 @@ void DeformableWorld::Snapshots::SaveForces(const DeformableWorld& world, WorldS
   }
 }
 
-void DeformableWorld::Snapshots::CheckDeformables(const DeformableWorld& world,
-                                                  const WorldSnapshot& snapshot) {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::Snapshots::CheckDeformables(const DeformableWorldOf& world,
+                                                                 const WorldSnapshot& snapshot) {
   TAUT_DEMAND(snapshot.deformables.size() == world.bodies_.size(),
               "RestoreSnapshot: the world has ", world.bodies_.size(),
               " deformable bodies, the snapshot ", snapshot.deformables.size());
@@ -125,8 +132,9 @@ void DeformableWorld::Snapshots::CheckDeformables(const DeformableWorld& world,
                 ") is not a pair of this world's ", world.bodies_.size(), " deformable bodies");
 }
 
-void DeformableWorld::Snapshots::RestoreDeformables(DeformableWorld& world,
-                                                    const WorldSnapshot& snapshot) {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::Snapshots::RestoreDeformables(DeformableWorldOf& world,
+                                                                   const WorldSnapshot& snapshot) {
   for (size_t b = 0; b < world.bodies_.size(); ++b) {
     Entry& entry = *world.bodies_[b];
     DeformableBody::State state = snapshot.deformables[b].body;
@@ -159,8 +167,9 @@ void DeformableWorld::Snapshots::RestoreDeformables(DeformableWorld& world,
 // handed out since the snapshot went to such a source: then a world reset again and again reuses
 // the same ids (keys stay below 2^16). Any other id handed out since (a limit or an attachment
 // added after the snapshot) keeps the current counter, so ids stay unique.
-int DeformableWorld::Snapshots::CalcRestoredNextSourceId(const DeformableWorld& world,
-                                                         const WorldSnapshot& snapshot) {
+template <class BulletWorld>
+int DeformableWorldOf<BulletWorld>::Snapshots::CalcRestoredNextSourceId(
+    const DeformableWorldOf& world, const WorldSnapshot& snapshot) {
   const int saved = snapshot.next_source_id;
   const int current = world.next_source_id_;
   if (current <= saved) return saved;
@@ -171,8 +180,9 @@ int DeformableWorld::Snapshots::CalcRestoredNextSourceId(const DeformableWorld& 
   return replaced == current - saved ? saved : current;
 }
 
-void DeformableWorld::Snapshots::RestoreSourceIds(DeformableWorld& world,
-                                                  const WorldSnapshot& snapshot) {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::Snapshots::RestoreSourceIds(DeformableWorldOf& world,
+                                                                 const WorldSnapshot& snapshot) {
   const int next_source_id = CalcRestoredNextSourceId(world, snapshot);
   // Pair sources: the saved ones with their ids, no others.
   decltype(world.pair_contacts_) pairs;
@@ -194,8 +204,9 @@ void DeformableWorld::Snapshots::RestoreSourceIds(DeformableWorld& world,
   world.next_source_id_ = next_source_id;
 }
 
-void DeformableWorld::Snapshots::RestoreForces(DeformableWorld& world,
-                                               const WorldSnapshot& snapshot) {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::Snapshots::RestoreForces(DeformableWorldOf& world,
+                                                              const WorldSnapshot& snapshot) {
   const WorldSnapshot::Forces& saved = snapshot.forces;
   auto body = [&world](int b) -> const DeformableBody* {
     return b >= 0 ? &world.bodies_[b]->object->body() : nullptr;
@@ -217,31 +228,38 @@ void DeformableWorld::Snapshots::RestoreForces(DeformableWorld& world,
   for (size_t l = 0; l < forces.limits.size(); ++l) forces.limits[l].body = body(saved.limits[l]);
 }
 
-WorldSnapshot DeformableWorld::SaveSnapshot() const {
+template <class BulletWorld>
+WorldSnapshot DeformableWorldOf<BulletWorld>::SaveSnapshot() const {
   WorldSnapshot snapshot;
   Snapshots::SaveDeformables(*this, snapshot);
   Snapshots::SaveSourceIds(*this, snapshot);
   snapshot.bullet = SaveBulletWorldState(*this);
-  snapshot.local_time = m_localTime;
-  snapshot.fixed_time_step = m_fixedTimeStep;
+  snapshot.local_time = this->m_localTime;
+  snapshot.fixed_time_step = this->m_fixedTimeStep;
   snapshot.last_step_stats = stats_;
   snapshot.last_call_stats = call_stats_;
   Snapshots::SaveForces(*this, snapshot);
   return snapshot;
 }
 
-void DeformableWorld::RestoreSnapshot(const WorldSnapshot& snapshot) {
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::RestoreSnapshot(const WorldSnapshot& snapshot) {
   Snapshots::CheckDeformables(*this, snapshot);
   CheckBulletWorldState(snapshot.bullet, *this);
   Snapshots::RestoreDeformables(*this, snapshot);
   if (!SnapshotSkip("ids")) Snapshots::RestoreSourceIds(*this, snapshot);
   // After the deformables: Bullet's collision detection may run, and sees their restored bounds.
   RestoreBulletWorldState(snapshot.bullet, *this);
-  if (!SnapshotSkip("localtime")) m_localTime = snapshot.local_time;
-  m_fixedTimeStep = snapshot.fixed_time_step;
+  if (!SnapshotSkip("localtime")) this->m_localTime = snapshot.local_time;
+  this->m_fixedTimeStep = snapshot.fixed_time_step;
   stats_ = snapshot.last_step_stats;
   call_stats_ = snapshot.last_call_stats;
   Snapshots::RestoreForces(*this, snapshot);
 }
+
+template WorldSnapshot DeformableWorldOf<btDiscreteDynamicsWorld>::SaveSnapshot() const;
+template void DeformableWorldOf<btDiscreteDynamicsWorld>::RestoreSnapshot(const WorldSnapshot&);
+template WorldSnapshot DeformableWorldOf<btMultiBodyDynamicsWorld>::SaveSnapshot() const;
+template void DeformableWorldOf<btMultiBodyDynamicsWorld>::RestoreSnapshot(const WorldSnapshot&);
 
 }  // namespace taut

@@ -41,8 +41,8 @@ int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::strin
   fs::create_directories(out_dir);
   std::unique_ptr<taut::Scene> scene = info.make();
   if (SolverChoice() != taut::IslandSolverKind::kAuto)
-    scene->world().mutable_solver_settings().solver = SolverChoice();
-  scene->world().SetThreadCount(ThreadCount());
+    scene->mutable_solver_settings().solver = SolverChoice();
+  scene->SetThreadCount(ThreadCount());
   std::ofstream csv(out_dir + "/steps.csv");
   csv.precision(17);
   csv << "step,time_s,ms_step,ms_unconstrained,ms_rows,ms_solve,ms_rigid";
@@ -73,7 +73,7 @@ int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::strin
     scene->Measure(dt);
     const double ms = std::chrono::duration<double, std::milli>(t1 - t0).count();
     ms_steps.push_back(ms);
-    const taut::StepStats& s = scene->world().last_step_stats();
+    const taut::StepStats& s = scene->last_step_stats();
     max_sqp = std::max(max_sqp, s.sqp_iterations);
     total_sqp += s.sqp_iterations;
     unconverged_steps += s.converged ? 0 : 1;

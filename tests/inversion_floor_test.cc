@@ -49,9 +49,10 @@ CrushResult CrushBlock(double inversion_floor) {
 TEST(InversionFloorTest, CrushedBlockKeepsEveryStretchAboveTheFloor) {
   const CrushResult without = CrushBlock(0.0);
   const CrushResult with = CrushBlock(kDefaultInversionFloor);
-  std::printf("[ crushed block ] min principal stretch: no floor %.3f, floor %.1f: %.4f (%d "
-              "unconverged of 30)\n",
-              without.min_stretch, kDefaultInversionFloor, with.min_stretch, with.unconverged);
+  std::printf(
+      "[ crushed block ] min principal stretch: no floor %.3f, floor %.1f: %.4f (%d "
+      "unconverged of 30)\n",
+      without.min_stretch, kDefaultInversionFloor, with.min_stretch, with.unconverged);
   // The load inverts the elements when only the x limits hold them ...
   EXPECT_LT(without.min_stretch, 0.0);
   // ... and the floor holds every stretch at s_floor within the solver's tolerance (1e-3 in C

@@ -102,12 +102,11 @@ std::shared_ptr<const ContactSurface> SceneSurfaceExtractor::GetSurface(const Sc
 
 SceneSnapshot SceneSurfaceExtractor::Extract(const Scene& scene) {
   SceneSnapshot snapshot;
-  const DeformableWorld& world = scene.world();
-  std::vector<int> embedded(world.num_deformable_bodies(), -1);
+  std::vector<int> embedded(scene.num_deformable_bodies(), -1);
   for (int i = 0; i < scene.num_embedded_surfaces(); ++i)
     embedded[scene.embedded_surface_body(i)] = i;
-  for (int b = 0; b < world.num_deformable_bodies(); ++b) {
-    const DeformableBody& body = world.deformable_body(b);
+  for (int b = 0; b < scene.num_deformable_bodies(); ++b) {
+    const DeformableBody& body = scene.deformable_body(b);
     DeformableState state;
     state.surface = GetSurface(scene, body.model(), embedded[b]);
     state.x = body.x();
@@ -116,7 +115,7 @@ SceneSnapshot SceneSurfaceExtractor::Extract(const Scene& scene) {
     state.smooth = embedded[b] >= 0;
     snapshot.deformables.push_back(std::move(state));
   }
-  const btCollisionObjectArray& objects = world.getCollisionObjectArray();
+  const btCollisionObjectArray& objects = scene.collision_objects();
   for (int i = 0; i < objects.size(); ++i) {
     const btRigidBody* rigid = btRigidBody::upcast(objects[i]);
     if (rigid == nullptr) continue;

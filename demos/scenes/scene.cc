@@ -16,8 +16,8 @@ void Scene::Simulate(double dt) { world().stepSimulation(dt, 1, dt); }
 
 void Scene::WriteVtkFrame(const std::string& dir, int frame, double time) const {
   if (time < 0.0) time = frame;
-  for (int b = 0; b < world().num_deformable_bodies(); ++b) {
-    const DeformableBody& body = world().deformable_body(b);
+  for (int b = 0; b < num_deformable_bodies(); ++b) {
+    const DeformableBody& body = deformable_body(b);
     const TetMesh* mesh = body.rest_tet_mesh();
     const HexLattice* lattice = body.rest_hex_lattice();
     if (mesh == nullptr && lattice == nullptr) continue;
@@ -36,10 +36,10 @@ void Scene::WriteVtkFrame(const std::string& dir, int frame, double time) const 
     const std::vector<Vec3> positions = CalcEmbeddedSurfacePositions(i);
     char name[64];
     std::snprintf(name, sizeof(name), "_surface_%06d", frame);
-    const std::string base = dir + "/" + world().deformable_body(embedded_[i].body).name() + name;
+    const std::string base = dir + "/" + deformable_body(embedded_[i].body).name() + name;
     WriteVtkSurface(base + ".vtk", positions, embedded_[i].surface.triangles);
     WriteEmbeddedSurfaceObj(base + ".obj", positions, embedded_[i].surface.triangles);
-    const std::string& body_name = world().deformable_body(embedded_[i].body).name();
+    const std::string& body_name = deformable_body(embedded_[i].body).name();
     vtk_series_.Add(dir, body_name + "_surface", body_name + name + ".vtk", time);
   }
 }
@@ -74,14 +74,14 @@ std::vector<Scene::KeyFrame> CollectPeakKeyFrames(int step, int num_steps, doubl
 }
 
 int Scene::AttachEmbeddedSurface(int body, const SurfaceMesh& surface) {
-  const ElementModel& model = world().deformable_body(body).model();
+  const ElementModel& model = deformable_body(body).model();
   embedded_.push_back({body, MakeEmbeddedBodyContactSurface(model, surface)});
   return static_cast<int>(embedded_.size()) - 1;
 }
 
 std::vector<Vec3> Scene::CalcEmbeddedSurfacePositions(int i) const {
   const EmbeddedSurfaceOutput& out = embedded_[i];
-  return CalcContactPointPositions(out.surface, world().deformable_body(out.body).x());
+  return CalcContactPointPositions(out.surface, deformable_body(out.body).x());
 }
 
 namespace {
@@ -97,12 +97,12 @@ void HashBytes(uint64_t& hash, const void* data, size_t size) {
 
 uint64_t Scene::CalcStateHash() const {
   uint64_t hash = 14695981039346656037ull;
-  for (int b = 0; b < world().num_deformable_bodies(); ++b) {
-    const DeformableBody& body = world().deformable_body(b);
+  for (int b = 0; b < num_deformable_bodies(); ++b) {
+    const DeformableBody& body = deformable_body(b);
     HashBytes(hash, body.x().data(), sizeof(double) * body.x().size());
     HashBytes(hash, body.v().data(), sizeof(double) * body.v().size());
   }
-  const btCollisionObjectArray& objects = world().getCollisionObjectArray();
+  const btCollisionObjectArray& objects = collision_objects();
   for (int i = 0; i < objects.size(); ++i) {
     const btRigidBody* rigid = btRigidBody::upcast(objects[i]);
     if (rigid == nullptr) continue;

@@ -62,6 +62,17 @@ class Scene {
 
   DeformableWorld& world() { return holder_.world; }
   const DeformableWorld& world() const { return holder_.world; }
+  // The world the scene steps, as generic code sees it (VTK frames, state hashes, pictures, the
+  // demo's statistics): world() unless a scene steps a world of its own (GripperScene: a
+  // DeformableMultiBodyWorld), which then overrides all six.
+  virtual int num_deformable_bodies() const { return world().num_deformable_bodies(); }
+  virtual const DeformableBody& deformable_body(int b) const { return world().deformable_body(b); }
+  virtual const btCollisionObjectArray& collision_objects() const {
+    return world().getCollisionObjectArray();
+  }
+  virtual const StepStats& last_step_stats() const { return world().last_step_stats(); }
+  virtual SqpSettings& mutable_solver_settings() { return world().mutable_solver_settings(); }
+  virtual void SetThreadCount(int threads) { world().SetThreadCount(threads); }
   // FNV-1a hash of every deformable x, v and every rigid transform and velocity (bitwise).
   uint64_t CalcStateHash() const;
 

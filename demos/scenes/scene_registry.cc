@@ -3,6 +3,7 @@
 #include "demos/scenes/collapsing_sphere_scene.h"
 #include "demos/scenes/falling_sphere_scene.h"
 #include "demos/scenes/finger_scene.h"
+#include "demos/scenes/gripper_scene.h"
 #include "demos/scenes/hex_beam_scene.h"
 #include "demos/scenes/scene.h"
 #include "demos/scenes/tet_beam_scene.h"
@@ -52,6 +53,11 @@ const std::vector<SceneInfo>& SceneRegistry() {
        "three rigid boxes (20, 10, 5 kg) stacked on a soft 32-hex sphere (500 kPa, U_e <= 0.5 J) "
        "on the ground: rigid-rigid contacts inside the deformable island",
        480, 1.0 / 240.0, [] { return std::make_unique<BoxOnSphereScene>(); }},
+      {"gripper",
+       "a two-finger btMultiBody gripper (prismatic joints with motors, 15 N per finger) squeezes "
+       "a soft strain-limited 384-tet cube (100 kPa, stretch in [0.9, 1.1]) and lifts it 5 cm "
+       "off the ground: links, motors and the cube in one island",
+       288, 1.0 / 240.0, [] { return std::make_unique<GripperScene>(); }},
   };
   return scenes;
 }
