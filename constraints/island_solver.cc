@@ -46,22 +46,32 @@ void IslandSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
                          StepStats& stats) {
   const IslandSolverKind kind = ChoosePath(bodies, settings);
   if (primal_steps_left_ > 0) --primal_steps_left_;
+  const bool retry =
+      settings.solver == IslandSolverKind::kAuto && settings.retry_failed_step_on_other_path;
+  KeyedMultipliers warm_start;
+  if (retry) {
+    warm_start = warm_;
+    start_v_.resize(bodies.size());
+    for (size_t b = 0; b < bodies.size(); ++b) start_v_[b] = bodies[b]->v();
+  }
+  SolveOn(kind, h, bodies, sources, settings, stats);
+  if (retry && !stats.converged) {
+    const IslandSolverKind other =
+        kind == IslandSolverKind::kPrimal ? IslandSolverKind::kDual : IslandSolverKind::kPrimal;
+    RetryOn(other, h, bodies, sources, settings, std::move(warm_start), stats);
+  }
+  last_rows_ = stats.rows_total();
+}
+
+void IslandSolver::SolveOn(IslandSolverKind kind, double h, const std::vector<IslandBody*>& bodies,
+                           const std::vector<ConstraintSource*>& sources,
+                           const SqpSettings& settings, StepStats& stats) {
   if (kind == IslandSolverKind::kPrimal) {
     primal_.Solve(h, bodies, sources, settings, warm_, stats);
     solved_primal_ = true;
   } else {
-    const bool retry =
-        settings.solver == IslandSolverKind::kAuto && settings.retry_failed_dual_on_primal;
-    KeyedMultipliers warm_start;
-    if (retry) {
-      warm_start = warm_;
-      start_v_.resize(bodies.size());
-      for (size_t b = 0; b < bodies.size(); ++b) start_v_[b] = bodies[b]->v();
-    }
     SolveDual(h, bodies, sources, settings, stats);
-    if (retry && !stats.converged) RetryOnPrimal(h, bodies, sources, settings, warm_start, stats);
   }
-  last_rows_ = stats.rows_total();
 }
 
 void IslandSolver::SolveDual(double h, const std::vector<IslandBody*>& bodies,
@@ -83,26 +93,30 @@ void IslandSolver::SolveDual(double h, const std::vector<IslandBody*>& bodies,
   }
 }
 
-void IslandSolver::RetryOnPrimal(double h, const std::vector<IslandBody*>& bodies,
-                                 const std::vector<ConstraintSource*>& sources,
-                                 const SqpSettings& settings, const KeyedMultipliers& warm_start,
-                                 StepStats& stats) {
-  dual_v_.resize(bodies.size());
+void IslandSolver::RetryOn(IslandSolverKind other, double h,
+                           const std::vector<IslandBody*>& bodies,
+                           const std::vector<ConstraintSource*>& sources,
+                           const SqpSettings& settings, KeyedMultipliers warm_start,
+                           StepStats& stats) {
+  // Keep the first answer (velocities, warm starts, path) to come back to.
+  first_v_.resize(bodies.size());
   for (size_t b = 0; b < bodies.size(); ++b) {
-    dual_v_[b] = bodies[b]->v();
+    first_v_[b] = bodies[b]->v();
     bodies[b]->set_v(start_v_[b]);
   }
-  KeyedMultipliers warm = warm_start;
+  KeyedMultipliers first_warm = std::move(warm_);
+  const bool first_primal = solved_primal_;
+  warm_ = std::move(warm_start);
   StepStats retry;
-  primal_.Solve(h, bodies, sources, settings, warm, retry);
+  SolveOn(other, h, bodies, sources, settings, retry);
   if (retry.converged || CalcCertificateError(retry) < CalcCertificateError(stats)) {
     AddDroppedSolveWork(stats, retry);
     stats = retry;
-    warm_ = std::move(warm);
-    solved_primal_ = true;
   } else {
     AddDroppedSolveWork(retry, stats);
-    for (size_t b = 0; b < bodies.size(); ++b) bodies[b]->set_v(dual_v_[b]);
+    warm_ = std::move(first_warm);
+    solved_primal_ = first_primal;
+    for (size_t b = 0; b < bodies.size(); ++b) bodies[b]->set_v(first_v_[b]);
   }
   stats.islands_retried++;
 }

@@ -59,15 +59,19 @@ class IslandSolver {
   // The path of this step: settings.solver, or for kAuto the rule of ChooseAuto.
   IslandSolverKind ChoosePath(const std::vector<IslandBody*>& bodies,
                               const SqpSettings& settings) const;
+  // One solve on the path `kind` (the dual with the failure rule of kAuto).
+  void SolveOn(IslandSolverKind kind, double h, const std::vector<IslandBody*>& bodies,
+               const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
+               StepStats& stats);
   // The dual path, with the failure rule of kAuto (primal_steps_left_).
   void SolveDual(double h, const std::vector<IslandBody*>& bodies,
                  const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
                  StepStats& stats);
-  // After a failed dual step (kAuto, retry_failed_dual_on_primal): the primal path from the
-  // step's start velocities `start` and warm starts `warm_start`; keeps the better answer.
-  void RetryOnPrimal(double h, const std::vector<IslandBody*>& bodies,
-                     const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
-                     const KeyedMultipliers& warm_start, StepStats& stats);
+  // After a failed step (kAuto, retry_failed_step_on_other_path): the path `other` from the
+  // step's start velocities (start_v_) and warm starts `warm_start`; keeps the better answer.
+  void RetryOn(IslandSolverKind other, double h, const std::vector<IslandBody*>& bodies,
+               const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
+               KeyedMultipliers warm_start, StepStats& stats);
 
   SqpSolver dual_;
   PrimalSolver primal_;
@@ -76,7 +80,7 @@ class IslandSolver {
   int primal_steps_left_ = 0;  // > 0: the dual path failed recently, stay primal
   int primal_window_ = kPrimalStepsAfterDualFailure;  // primal steps after the next failure
   bool solved_primal_ = false;                        // the last Solve took the primal path
-  std::vector<VecX> start_v_, dual_v_;  // retry: velocities at the start and of the dual answer
+  std::vector<VecX> start_v_, first_v_;  // retry: velocities at the start and of the first path
 };
 
 }  // namespace taut

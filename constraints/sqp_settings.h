@@ -74,10 +74,10 @@ struct SqpSettings {
   // Which island solver runs (constraints/island_solver.h) and the primal path's settings.
   IslandSolverKind solver = IslandSolverKind::kAuto;
   PrimalSettings primal;
-  // kAuto only: when the dual path's step fails its certificate, solve the step again from its
-  // start on the primal path and keep whichever answer has the smaller residual (converged
+  // kAuto only: when the path taken fails the step's certificate, solve the step again from its
+  // start on the other path and keep whichever answer has the smaller residual (converged
   // first). Costs a second solve on failed steps only. Default true.
-  bool retry_failed_dual_on_primal = true;
+  bool retry_failed_step_on_other_path = true;
 };
 
 }  // namespace taut

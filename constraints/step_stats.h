@@ -57,8 +57,8 @@ struct StepStats {
   int pcg_iterations = 0;         // primal path: PCG iterations (1 per Newton step when local)
   int newton_factorizations = 0;  // primal path: Newton matrices factored (fewer than Newton
                                   // iterations when bodies keep their factor, PrimalSettings)
-  // Islands whose dual step failed its certificate and was solved again on the primal path
-  // (SqpSettings::retry_failed_dual_on_primal); islands_dual / islands_primal count the path
+  // Islands whose step failed its certificate and was solved again on the other path
+  // (SqpSettings::retry_failed_step_on_other_path); islands_dual / islands_primal count the path
   // whose answer was kept, the work counts and times include both solves.
   int islands_retried = 0;
   // Convergence certificate at the end of the step (constraints/kkt_certificate.h), worst island:

@@ -88,7 +88,7 @@ TEST(FingerSceneTest, CertificateStepsCertifyTheHoldsBetweenPresses) {
     FingerScene scene(FingerScene::DefaultPresses(), FingerSceneSettings());
     scene.world().mutable_solver_settings().certificate_steps = on != 0;
     // The dual path's own figures: no second solve on the primal path for its failed steps.
-    scene.world().mutable_solver_settings().retry_failed_dual_on_primal = false;
+    scene.world().mutable_solver_settings().retry_failed_step_on_other_path = false;
     for (int step = 0; step < 5000 && scene.current_press() < scene.num_presses(); ++step) {
       scene.Step(1e-3);
       const StepStats& stats = scene.world().last_step_stats();

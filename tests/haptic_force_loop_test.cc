@@ -337,9 +337,11 @@ TEST(HapticForceLoopTest, DynamicToolInTheIsland) {
   std::printf("dynamic box: report %.6f N, loop %.6f N (%d rows, %d tool rows, %d sweeps)\n",
               reported.force.z(), w0.force.z(), loop.lcp().size(), loop.num_tool_rows(), w0.sweeps);
   // This island (102 rows on 225 free DOFs) takes the primal path, whose multipliers solve the
-  // frozen LCP to its own tolerance (measured 5e-5 of the force).
+  // frozen LCP to the certificate's tolerance (complementarity 1e-3 in C units), the loop's PGS
+  // to its own: measured 5e-5 of the force, and 2.5e-3 once failed steps of the rest were
+  // retried on the other path (a different trajectory to the same rest).
   EXPECT_GT(holder.world.last_step_stats().islands_primal, 0);
-  EXPECT_LT((w0.force - reported.force).norm(), 1e-3 * reported.force.norm());
+  EXPECT_LT((w0.force - reported.force).norm(), 5e-3 * reported.force.norm());
   EXPECT_LT((w0.torque - reported.torque).norm(), 1e-3 * reported.force.norm() * 0.02);
   double last = w0.force.z();
   for (double d : {0.5e-6, 1e-6, 2e-6, 4e-6}) {
