@@ -93,8 +93,7 @@ void IslandSolver::SolveDual(double h, const std::vector<IslandBody*>& bodies,
   }
 }
 
-void IslandSolver::RetryOn(IslandSolverKind other, double h,
-                           const std::vector<IslandBody*>& bodies,
+void IslandSolver::RetryOn(IslandSolverKind other, double h, const std::vector<IslandBody*>& bodies,
                            const std::vector<ConstraintSource*>& sources,
                            const SqpSettings& settings, KeyedMultipliers warm_start,
                            StepStats& stats) {
