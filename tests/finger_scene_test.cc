@@ -77,6 +77,36 @@ TEST(FingerSceneTest, BoneIsInsideTheFleshAndBadSettingsThrow) {
   EXPECT_THROW(FingerScene({}), InputError);
 }
 
+// A locked advance (the bone pushes tissue whose limits already hold it against the table: no
+// velocity satisfies every row) cannot be certified; the scene takes it back from a snapshot and
+// steps again at the last travel, so every step it keeps is certified. The taken-back advances
+// did break the limits, so taking them back was needed.
+TEST(FingerSceneTest, LockedAdvancesAreTakenBackSoEveryKeptStepIsCertified) {
+  const FingerSceneSettings settings;
+  FingerScene scene(FingerScene::DefaultPresses(), settings);
+  int steps = 0, unconverged = 0, locks = 0;
+  for (; steps < 5000 && scene.current_press() < scene.num_presses(); ++steps) {
+    scene.Step(1e-3);
+    unconverged += scene.world().last_step_stats().converged ? 0 : 1;
+  }
+  ASSERT_EQ(scene.current_press(), scene.num_presses());
+  for (int p = 0; p < scene.num_presses(); ++p) {
+    const FingerPressResult& result = scene.result(p);
+    EXPECT_LE(result.max_violation, 2.0 * settings.solver_tolerance) << result.name;
+    if (result.stop_reason != "lock") continue;
+    ++locks;
+    std::printf("%s: the advance taken back reached violation %.2e, penetration %.2e m\n",
+                result.name.c_str(), result.lock_violation, result.lock_penetration);
+    EXPECT_GT(std::max(result.lock_violation / settings.solver_tolerance,
+                       result.lock_penetration / settings.lock_penetration),
+              1.0)
+        << result.name;
+  }
+  std::printf("%d steps, %d unconverged, %d presses locked\n", steps, unconverged, locks);
+  EXPECT_EQ(locks, 2);  // side and tip, anisotropic
+  EXPECT_EQ(unconverged, 0);
+}
+
 // The dual path's certificate steps (SqpSettings::certificate_steps, docs/math.md §5.7): in the
 // holds between presses the merit halves every full SQP step, so the SQP converges linearly at
 // rate 1/2 and ends its 10 iterations uncertified; taking the full steps that lower the
@@ -85,7 +115,10 @@ TEST(FingerSceneTest, CertificateStepsCertifyTheHoldsBetweenPresses) {
   int unconverged[2] = {0, 0};
   double max_violation[2] = {0.0, 0.0};
   for (int on = 0; on < 2; ++on) {
-    FingerScene scene(FingerScene::DefaultPresses(), FingerSceneSettings());
+    // Every step counted as stepped: locked advances kept, not taken back.
+    FingerSceneSettings settings;
+    settings.take_back_locked_advances = false;
+    FingerScene scene(FingerScene::DefaultPresses(), settings);
     scene.world().mutable_solver_settings().certificate_steps = on != 0;
     // The dual path's own figures: no second solve on the primal path for its failed steps.
     scene.world().mutable_solver_settings().retry_failed_step_on_other_path = false;

@@ -193,7 +193,23 @@ void FingerScene::UpdateBoneTravel(double dt) {
 }
 
 void FingerScene::Simulate(double dt) {
-  if (current_ < num_presses()) UpdateBoneTravel(dt);
+  if (current_ >= num_presses()) return Scene::Simulate(dt);
+  // Only an advance against the table can lock; a snapshot before it lets it be taken back.
+  const bool guarded =
+      settings_.take_back_locked_advances && !stopped_ && results_[current_].touched;
+  if (guarded) advance_start_ = world().SaveSnapshot();
+  UpdateBoneTravel(dt);
+  Scene::Simulate(dt);
+  if (guarded && !world().last_step_stats().converged) RetreatFromLockedAdvance(dt);
+}
+
+void FingerScene::RetreatFromLockedAdvance(double dt) {
+  locked_x_ = finger_->x();
+  retreated_ = true;
+  world().RestoreSnapshot(advance_start_);
+  travel_ = last_travel_;
+  stopped_ = true;
+  UpdateBoneTravel(0.0);
   Scene::Simulate(dt);
 }
 
@@ -231,9 +247,9 @@ double FingerScene::CalcElasticReaction() const {
   return force;
 }
 
-double FingerScene::CalcLowestGap() const {
+double FingerScene::CalcLowestGap(const VecX& x) const {
   double lowest = HUGE_VAL;
-  for (int i : boundary_nodes_) lowest = std::min(lowest, finger_->node_position(i).z());
+  for (int i : boundary_nodes_) lowest = std::min(lowest, x[3 * i + 2]);
   return lowest;
 }
 
@@ -261,8 +277,16 @@ void FingerScene::MeasureStep() {
   result.mean_sqp_iterations = sqp_sum_ / result.steps;
   result.mean_pgs_sweeps = sweep_sum_ / result.steps;
   result.mean_ms_step = ms_sum_ / result.steps;
-  const double gap = CalcLowestGap();
+  const double gap = CalcLowestGap(finger_->x());
   const double violation = limits_->CalcMaxViolation(finger_->x());
+  if (retreated_) {
+    // The advance taken back before this step was stepped again at the last travel.
+    retreated_ = false;
+    result.lock_violation = limits_->CalcMaxViolation(locked_x_);
+    result.lock_penetration = -CalcLowestGap(locked_x_);
+    result.stop_reason = "lock";
+    result.indentation = std::max(0.0, travel_ - contact_travel_);
+  }
   const bool lock =
       !stopped_ && (violation > settings_.lock_violation || -gap > settings_.lock_penetration);
   if (lock) {
@@ -314,7 +338,7 @@ void FingerScene::AppendCsvValues(std::vector<double>& values) const {
   values.push_back(reaction_);
   values.push_back(CalcElasticReaction());
   values.push_back(CalcContactArea());
-  values.push_back(CalcLowestGap());
+  values.push_back(CalcLowestGap(finger_->x()));
   values.push_back(limits_->CalcMaxViolation(finger_->x()));
 }
 

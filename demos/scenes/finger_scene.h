@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "bullet_bridge/world_snapshot.h"
 #include "demos/scenes/scene.h"
 #include "plugin/finger_mesher.h"
 
@@ -48,6 +49,9 @@ struct FingerSceneSettings {
   double mass_damping = 2.0;       // Rayleigh alpha [1/s]
   // SQP violation tolerance of the limit rows (C fraction), > 0; stationarity 100 times it.
   double solver_tolerance = 1e-5;
+  // An advance after the first contact whose step is not certified is taken back from a snapshot
+  // and stepped again at the last travel (false: kept, and judged by the lock thresholds alone).
+  bool take_back_locked_advances = true;
   CapsuleMeshSettings mesh;  // 7 x 3 x 3 cells -> 378 tets
 };
 
@@ -79,10 +83,12 @@ struct FingerPressResult {
 // once its strain along the press reaches the limit, and a prescribed bone travel beyond that
 // cannot be followed (the QP turns infeasible), so equal travels would not compare compliance.
 // Each press: the bone (pinned to the inner nodes) moves down at bone_speed, slowing near the
-// target, until the table reaction reaches target_force ("force"), the tissue locks ("lock": a
-// limit or the contact is broken beyond the lock thresholds; the bone steps back to the last
-// travel that held them and the reaction is the one it locked at), or the travel cap ("travel");
-// then it holds still for hold_time. The table reaction is read from the step's contact forces:
+// target, until the table reaction reaches target_force ("force"), the tissue locks ("lock": an
+// advance whose constrained step cannot be certified, or that breaks a limit or the contact beyond
+// the lock thresholds; the world goes back to the step's start, from a snapshot, and the step is
+// taken again with the bone at the last travel that held, so the locked advance is never kept, and
+// the reaction is the one it locked at), or the travel cap ("travel"); then it holds still for
+// hold_time. The table reaction is read from the step's contact forces:
 // the z components of the table's forces on the finger, R = sum_c lambda_n,c n_c . z / h (the
 // solved impulses, DeformableWorld::last_contacts; the table is frictionless). Indentation = bone
 // travel after the first contact: the table does not move and nothing sinks into it, so the tissue
@@ -100,7 +106,8 @@ class FingerScene : public Scene {
   // Longest simulated time one press may take with these settings [s].
   static double CalcPressDuration(const FingerSceneSettings& settings);
 
-  // Moves the bone (UpdateBoneTravel) and steps the world.
+  // Moves the bone (UpdateBoneTravel) and steps the world; an advance after the first contact
+  // that cannot be followed is taken back (RetreatFromLockedAdvance).
   void Simulate(double dt) override;
   // MeasureStep, then the press's clock; ends the press when its hold or duration is over.
   void Measure(double dt) override;
@@ -133,6 +140,9 @@ class FingerScene : public Scene {
   void EndPress();
   // Picks the bone travel of the next step (press, stop or step back).
   void UpdateBoneTravel(double dt);
+  // The advance just stepped locked (its step is not certified): keeps its positions for
+  // MeasureStep, restores the world to the step's start and steps again at the last travel.
+  void RetreatFromLockedAdvance(double dt);
   // Records the step just taken into the current result and stop state.
   void MeasureStep();
   // Table reaction of the last step: the z force of the table's contacts on the finger [N].
@@ -143,8 +153,8 @@ class FingerScene : public Scene {
   double CalcFreeWeight() const;
   // Elastic part of the table reaction (FingerPressResult::elastic_reaction) [N].
   double CalcElasticReaction() const;
-  // Lowest node height above the table [m].
-  double CalcLowestGap() const;
+  // Lowest node height above the table at node positions x (3N) [m].
+  double CalcLowestGap(const VecX& x) const;
 
   std::vector<FingerPress> presses_;
   FingerSceneSettings settings_;
@@ -169,6 +179,9 @@ class FingerScene : public Scene {
   double travel_ = 0.0;               // bone travel downwards [m]
   double contact_travel_ = 0.0;       // travel at the first contact [m]
   bool stopped_ = false;
+  WorldSnapshot advance_start_;  // the world before the advance being stepped
+  bool retreated_ = false;       // this step's advance was taken back
+  VecX locked_x_;                // node positions the taken-back advance reached (3N) [m]
   double speed_factor_ = 1.0;  // fraction of bone_speed (slows down near the target)
   double reaction_ = 0.0;      // table reaction of the last accepted step [N]
   mutable VecX scratch_;       // elastic forces (3N)
