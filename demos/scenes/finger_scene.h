@@ -182,9 +182,9 @@ class FingerScene : public Scene {
   WorldSnapshot advance_start_;  // the world before the advance being stepped
   bool retreated_ = false;       // this step's advance was taken back
   VecX locked_x_;                // node positions the taken-back advance reached (3N) [m]
-  double speed_factor_ = 1.0;  // fraction of bone_speed (slows down near the target)
-  double reaction_ = 0.0;      // table reaction of the last accepted step [N]
-  mutable VecX scratch_;       // elastic forces (3N)
+  double speed_factor_ = 1.0;    // fraction of bone_speed (slows down near the target)
+  double reaction_ = 0.0;        // table reaction of the last accepted step [N]
+  mutable VecX scratch_;         // elastic forces (3N)
   double sqp_sum_ = 0.0, sweep_sum_ = 0.0, ms_sum_ = 0.0;
   int key_press_ = -1;  // last press shown in a key frame
 };
