@@ -85,7 +85,9 @@ FrameTestState MakeFrameTestState(std::mt19937* rng, const StrainLimitParams& pa
 // Rows whose frame factor is far from the hyperbolic |V'_ji| kink (there C is not C^2).
 bool IsAwayFromKink(const FrameTestState& state, const StrainLimitParams& params,
                     const StrainLimitRow& row) {
-  if (params.projection != StrainProjection::kHyperbolic) return true;
+  // Floor rows (kStrainFloorAxis) are functions of s_i alone: no frame factor, no kink.
+  if (params.projection != StrainProjection::kHyperbolic || row.key.axis == kStrainFloorAxis)
+    return true;
   const SignedSvd svd = CalcSignedSvd(CalcTetDeformationGradient(state.r, state.x));
   const Mat3 V_prime = state.Q.transpose() * svd.V;
   return std::abs(V_prime(row.key.axis, row.principal_index)) > 0.05;
