@@ -77,6 +77,43 @@ void IslandRows::OverwriteByKey(const KeyedMultipliers& from, VecX& values) cons
   }
 }
 
+namespace {
+// A look-ahead row joins only where the kept rows have nothing of its group: the strain rows of
+// one element form one group (whichever principal direction and bound: a sibling row linearized
+// at another point would only compete with the kept one), every other row is its own.
+std::uint64_t CalcLookAheadGroup(const ConstraintRow& row) {
+  if (row.type != RowType::kStrainLimit) return row.key;
+  return row.key >> kStrainLimitElementShift << kStrainLimitElementShift;
+}
+}  // namespace
+
+int IslandRows::SetLookAheadRows(const IslandRows& from, int num_kept,
+                                 const std::vector<std::uint64_t>& sticky, double h,
+                                 const std::vector<VecX>& v, const std::vector<VecX>& v_from) {
+  rows_.resize(num_kept);
+  for (std::vector<int>& rows : body_rows_)
+    while (!rows.empty() && rows.back() >= num_kept) rows.pop_back();
+  sorted_keys_.clear();
+  for (const ConstraintRow& row : rows_) sorted_keys_.push_back(CalcLookAheadGroup(row));
+  std::sort(sorted_keys_.begin(), sorted_keys_.end());
+  for (int c = 0; c < from.size(); ++c) {
+    const ConstraintRow& row = from[c];
+    // Limit rows only: contacts are collected within a margin before they touch, limit rows only
+    // within their activation margin, which one step of v* can cross.
+    if (!IsLimitRow(row) ||
+        std::binary_search(sorted_keys_.begin(), sorted_keys_.end(), CalcLookAheadGroup(row)) ||
+        !(row.violation() > 0.0 || std::binary_search(sticky.begin(), sticky.end(), row.key)))
+      continue;
+    const int r = size();
+    ConstraintRow& added = rows_.emplace_back(row);
+    // C(x) ~ C(x_from) + J (x - x_from), x - x_from = h (v - v_from).
+    added.C += h * (from.CalcRowVelocity(c, v) - from.CalcRowVelocity(c, v_from));
+    body_rows_[added.body].push_back(r);
+    if (added.body2 >= 0 && added.body2 != added.body) body_rows_[added.body2].push_back(r);
+  }
+  return size() - num_kept;
+}
+
 void IslandRows::Store(const VecX& lambda, KeyedMultipliers& to) const {
   to.clear();
   for (size_t c = 0; c < rows_.size(); ++c)

@@ -34,6 +34,15 @@ class IslandRows {
   // one takes an unclaimed value of a sibling key (same element and bound, another principal
   // direction: kStrainLimitDirectionBits); other rows keep theirs.
   void OverwriteByKey(const KeyedMultipliers& from, VecX& values) const;
+  // Look-ahead rows (the dual path's rows found at a QP step): keeps the first `num_kept` rows,
+  // then appends the limit rows of `from` (collected at velocities v_from) that have no row of
+  // their group among them (a strain row's group is its element; any other row's, its key) and that
+  // `from` violates or whose key is in `sticky` (sorted), linearized about this set's
+  // velocities v: C <- C + h J (v - v_from), their first-order value here. Returns the number of
+  // rows appended.
+  int SetLookAheadRows(const IslandRows& from, int num_kept,
+                       const std::vector<std::uint64_t>& sticky, double h,
+                       const std::vector<VecX>& v, const std::vector<VecX>& v_from);
   // Row counts by type into stats (rows_strain, ...).
   void CountTypes(StepStats& stats) const;
   // J v of a row for per-body velocities v.
@@ -53,8 +62,9 @@ class IslandRows {
   std::vector<ConstraintRow> rows_;
   std::vector<std::vector<int>> body_rows_;
   std::vector<VecX> x_;
-  mutable std::vector<char> claimed_;   // OverwriteByKey: entries of `from` taken
-  mutable std::vector<int> unmatched_;  // OverwriteByKey: strain rows without their key
+  mutable std::vector<char> claimed_;       // OverwriteByKey: entries of `from` taken
+  mutable std::vector<int> unmatched_;      // OverwriteByKey: strain rows without their key
+  std::vector<std::uint64_t> sorted_keys_;  // SetLookAheadRows: the kept rows' keys
 };
 
 }  // namespace taut

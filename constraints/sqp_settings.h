@@ -66,6 +66,11 @@ struct SqpSettings {
   // feasible and stationary. Off: the merit alone decides, and feasible and stationary stops.
   bool certificate_steps = true;
   double full_step_violation_factor = 10.0;
+  // Dual path: rows the full QP step violates that the QP did not have (elements and contacts
+  // outside the activation margin at x_k, which v* pushes past their limit) join the QP, shifted
+  // to x_k by their Jacobian, and the QP is solved again, up to this many times per SQP
+  // iteration (docs/math.md §5.7, "rows found at the QP step"). 0: off.
+  int max_row_discovery_passes = 3;
   double stalled_step = 0.1;       // feasible and last alpha below this: stop (stalled)
   PgsSettings pgs = DefaultPgs();  // sweeps and tolerance of each QP
   bool polish_active_set = true;   // refine an unconverged PGS answer by active-set solves

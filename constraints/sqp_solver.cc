@@ -171,6 +171,16 @@ void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     BuildQp(h, bodies, restoring);
     SolveQp(settings, stats);
     CalcQpVelocities(bodies, restoring);
+    full_rows_at_v_qp_ = false;
+    num_collected_ = rows_.size();
+    look_ahead_keys_.clear();
+    for (int pass = 0; !restoring && pass < settings.max_row_discovery_passes &&
+                       AddRowsViolatedAtQpStep(h, bodies, sources, distance_scale, stats);
+         ++pass) {
+      BuildQp(h, bodies, restoring);
+      SolveQp(settings, stats);
+      CalcQpVelocities(bodies, restoring);
+    }
     if (restoring) {
       TakeRestorationStep(h, bodies, sources, settings, stats);
     } else {
@@ -199,16 +209,16 @@ void SqpSolver::BeginSolve(const std::vector<IslandBody*>& bodies, const SqpSett
   } else {
     iterate_.clear();
   }
-  full_rows_at_v_k_ = false;
+  full_rows_at_v_k_ = full_rows_at_v_qp_ = false;
 }
 
 double SqpSolver::CollectRowsAtIterate(double h, const std::vector<IslandBody*>& bodies,
                                        const std::vector<ConstraintSource*>& sources,
                                        double distance_scale, StepStats& stats) {
   if (full_rows_at_v_k_) {
-    // A certificate step moved v_k to v_QP exactly: its rows are already collected there.
+    // A full step moved v_k to v_QP exactly: its rows are already collected there.
     std::swap(rows_, full_rows_);
-    full_rows_at_v_k_ = false;
+    full_rows_at_v_k_ = full_rows_at_v_qp_ = false;
     return full_violation_;
   }
   const auto t_rows = std::chrono::steady_clock::now();
@@ -264,6 +274,34 @@ void SqpSolver::CalcQpVelocities(const std::vector<IslandBody*>& bodies, bool re
   }
 }
 
+bool SqpSolver::AddRowsViolatedAtQpStep(double h, const std::vector<IslandBody*>& bodies,
+                                        const std::vector<ConstraintSource*>& sources,
+                                        double distance_scale, StepStats& stats) {
+  const auto t_rows = std::chrono::steady_clock::now();
+  full_violation_ = full_rows_.Collect(h, bodies, sources, v_qp_, distance_scale);
+  full_rows_at_v_qp_ = true;
+  const int had = rows_.size();
+  const int look_ahead =
+      rows_.SetLookAheadRows(full_rows_, num_collected_, look_ahead_keys_, h, v_k_, v_qp_);
+  stats.ms_rows += MsSince(t_rows);
+  // Done when no row joined: the same look-ahead rows, relinearized at this v_QP.
+  if (rows_.size() == had && look_ahead == had - num_collected_) {
+    bool same = true;
+    for (int c = num_collected_; c < rows_.size() && same; ++c)
+      same = std::binary_search(look_ahead_keys_.begin(), look_ahead_keys_.end(), rows_[c].key);
+    if (same) return false;
+  }
+  full_rows_at_v_qp_ = false;  // the QP is solved again: a new v_QP
+  look_ahead_keys_.clear();
+  for (int c = num_collected_; c < rows_.size(); ++c) look_ahead_keys_.push_back(rows_[c].key);
+  std::sort(look_ahead_keys_.begin(), look_ahead_keys_.end());
+  stats.rows_discovered += rows_.size() - had;
+  // Look-ahead rows start from 0 (the collected keep lambda_k).
+  lambda_.conservativeResize(rows_.size());
+  lambda_.tail(rows_.size() - num_collected_).setZero();
+  return true;
+}
+
 // Accepts the push only as far as it lowers the total violation (halving, as the merit).
 void SqpSolver::TakeRestorationStep(double h, const std::vector<IslandBody*>& bodies,
                                     const std::vector<ConstraintSource*>& sources,
@@ -313,6 +351,8 @@ double SqpSolver::TakeMeritStep(double h, const std::vector<IslandBody*>& bodies
   } else {
     for (size_t b = 0; b < nb; ++b) v_k_[b] += alpha * (v_qp_[b] - v_k_[b]);
     lambda_ += alpha * (lambda_qp_ - lambda_);
+    // A full step lands on v_QP (to rounding): the rows collected there serve the next iteration.
+    full_rows_at_v_k_ = alpha == 1.0 && full_rows_at_v_qp_;
   }
   return alpha;
 }

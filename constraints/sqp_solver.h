@@ -58,6 +58,11 @@ class SqpSolver {
   void SolveQp(const SqpSettings& settings, StepStats& stats);
   // v_QP from lambda_QP.
   void CalcQpVelocities(const std::vector<IslandBody*>& bodies, bool restoring);
+  // Rows at the full QP step v_QP that the QP lacked and v_QP violates join rows_, linearized
+  // about v_k (SqpSettings::max_row_discovery_passes); true when any did (solve the QP again).
+  bool AddRowsViolatedAtQpStep(double h, const std::vector<IslandBody*>& bodies,
+                               const std::vector<ConstraintSource*>& sources, double distance_scale,
+                               StepStats& stats);
   // Restoration: v_k, lambda_k pushed towards v_QP as far as the violation drops.
   void TakeRestorationStep(double h, const std::vector<IslandBody*>& bodies,
                            const std::vector<ConstraintSource*>& sources,
@@ -96,12 +101,15 @@ class SqpSolver {
   std::vector<VecX> x_;      // (num_bodies) positions at a trial velocity
   MatX W_;
   VecX q_, lambda_, lambda_qp_, w_;
-  IslandRows full_rows_;           // rows at the full QP step
-  double full_violation_ = 0.0;    // their largest violation (IslandRows::Collect)
-  bool full_rows_at_v_k_ = false;  // a certificate step was taken: full_rows_ are v_k's rows
-  VecX full_lambda_;               // lambda_QP on full_rows_
-  KeyedMultipliers qp_keyed_;      // lambda_QP by key
-  Eigen::RowVectorXd w_row_;       // one row of W being assembled
+  int num_collected_ = 0;                       // rows_ collected at v_k; look-ahead rows follow
+  std::vector<std::uint64_t> look_ahead_keys_;  // their keys, sorted
+  IslandRows full_rows_;                        // rows at the full QP step
+  double full_violation_ = 0.0;                 // their largest violation (IslandRows::Collect)
+  bool full_rows_at_v_k_ = false;               // a full step was taken: full_rows_ are v_k's rows
+  bool full_rows_at_v_qp_ = false;              // full_rows_ were collected at the current v_QP
+  VecX full_lambda_;                            // lambda_QP on full_rows_
+  KeyedMultipliers qp_keyed_;                   // lambda_QP by key
+  Eigen::RowVectorXd w_row_;                    // one row of W being assembled
   std::vector<VecX> v_k_, v_qp_, v_trial_, dv_;
   VecX scratch_, jt_;          // 3N work vectors (A dv, J^T lambda), reused across steps
   KeyedMultipliers previous_;  // last step's multipliers by key

@@ -41,6 +41,7 @@ void AddWork(const StepStats& part, StepStats& total) {
   total.pgs_sweeps += part.pgs_sweeps;
   total.restoration_iterations += part.restoration_iterations;
   total.active_set_solves += part.active_set_solves;
+  total.rows_discovered += part.rows_discovered;
   total.islands_dual += part.islands_dual;
   total.islands_primal += part.islands_primal;
   total.newton_iterations += part.newton_iterations;
@@ -101,6 +102,7 @@ void AddDroppedSolveWork(const StepStats& dropped, StepStats& kept) {
   kept.sqp_iterations += dropped.sqp_iterations;
   kept.restoration_iterations += dropped.restoration_iterations;
   kept.active_set_solves += dropped.active_set_solves;
+  kept.rows_discovered += dropped.rows_discovered;
   kept.newton_iterations += dropped.newton_iterations;
   kept.pcg_iterations += dropped.pcg_iterations;
   kept.newton_factorizations += dropped.newton_factorizations;

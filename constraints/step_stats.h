@@ -37,6 +37,7 @@ struct StepStats {
   int rows_node_height = 0;        // node-height rows (a free node above z_min)
   int pgs_sweeps = 0;              // total over SQP iterations
   int active_set_solves = 0;       // QPs refined by a direct active-set solve
+  int rows_discovered = 0;         // dual path: rows added at full QP steps (QPs solved again)
   int sqp_iterations = 0;          // including restoration iterations
   int restoration_iterations = 0;  // push-only iterations after the SQP cap
   // Violations in units of the limit rows' C (fraction of the limit): max(0, -C) of limit rows,
