@@ -34,6 +34,13 @@ int& ThreadCount() {
   return threads;
 }
 
+// The dual path's SQP iteration cap chosen by --sqp-iterations (0: the scene's,
+// SqpSettings::max_iterations).
+int& SqpIterationCap() {
+  static int cap = 0;
+  return cap;
+}
+
 // Runs the scene and writes its outputs; returns the process exit code.
 int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::string& out_dir,
              bool vtk, int vtk_every, bool png) {
@@ -42,6 +49,7 @@ int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::strin
   std::unique_ptr<taut::Scene> scene = info.make();
   if (SolverChoice() != taut::IslandSolverKind::kAuto)
     scene->mutable_solver_settings().solver = SolverChoice();
+  if (SqpIterationCap() > 0) scene->mutable_solver_settings().max_iterations = SqpIterationCap();
   scene->SetThreadCount(ThreadCount());
   std::ofstream csv(out_dir + "/steps.csv");
   csv.precision(17);
@@ -172,6 +180,9 @@ int main(int argc, char** argv) {
                  "Island solver: auto (per island by rows per DOF), dual (the papers' PGS) or "
                  "primal (augmented-Lagrangian Newton)")
       ->transform(CLI::CheckedTransformer(solvers, CLI::ignore_case));
+  app.add_option("--sqp-iterations", SqpIterationCap(),
+                 "SQP iteration cap of the dual path, >= 1 (default: the scene's, usually 10)")
+      ->check(CLI::PositiveNumber);
   app.add_option("--threads", ThreadCount(),
                  "Threads stepping the bodies and independent islands, >= 1 (default 1; results "
                  "are the same for any count)")
