@@ -38,24 +38,6 @@ FrozenIslandLcp::Result FrozenIslandLcp::Solve(const ToolTwist& u, const PgsSett
   return result;
 }
 
-std::vector<PgsRow> MakePgsRows(const IslandRows& rows) {
-  std::vector<PgsRow> pgs(rows.size(), MakeUnilateralRow());
-  for (int c = 0; c < rows.size(); ++c) {
-    const ConstraintRow& row = rows[c];
-    if (row.bilateral) pgs[c] = MakeBilateralRow(row.lo, row.hi);
-    if (row.friction_of == 0) continue;
-    // A friction pair on the Coulomb disk of its contact's normal row c - friction_of.
-    PgsRow& p = pgs[c];
-    p.kind = RowKind::kFriction;
-    p.cone = FrictionCone::kDisk;
-    p.normal = c - row.friction_of;
-    p.partner = row.friction_of == 1 ? c + 1 : c - 1;
-    p.lo = -std::numeric_limits<double>::infinity();
-    p.mu = row.mu;
-  }
-  return pgs;
-}
-
 namespace {
 // Y_b = A_b^-1 J_b^T (3 num_blocks x rows of b, body_rows order) without changing the body: a
 // deformable's held factor must be this step's A (a solve that would factor is refused).
@@ -125,7 +107,7 @@ FrozenIsland FreezeIsland(double h, const std::vector<IslandBody*>& bodies, cons
     });
     island.q0[c] = row.friction_of > 0 ? jv_ref : row.C / h + jv_ref - jv;
   }
-  island.rows = MakePgsRows(rows);
+  rows.CalcPgsRows(island.rows);
   island.lambda0 = lambda;
   return island;
 }

@@ -83,10 +83,6 @@ struct FrozenIsland {
 FrozenIsland FreezeIsland(double h, const std::vector<IslandBody*>& bodies, const IslandRows& rows,
                           const VecX& lambda, int prescribed = -1);
 
-// The PGS rows of `rows` (unilateral, bilateral with bounds, friction on its normal's disk),
-// as the dual path builds them (SqpSolver::BuildPgsRows).
-std::vector<PgsRow> MakePgsRows(const IslandRows& rows);
-
 // Stacks islands into one LCP: W block-diagonal, rows and J_t blocks in order (row indices of
 // friction rows shifted to the stacked numbering).
 FrozenIslandLcp StackFrozenIslands(const std::vector<FrozenIsland>& islands,

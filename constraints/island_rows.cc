@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "constraints/row_key_layouts.h"
 
@@ -112,6 +113,23 @@ int IslandRows::SetLookAheadRows(const IslandRows& from, int num_kept,
     if (added.body2 >= 0 && added.body2 != added.body) body_rows_[added.body2].push_back(r);
   }
   return size() - num_kept;
+}
+
+void IslandRows::CalcPgsRows(std::vector<PgsRow>& pgs) const {
+  pgs.assign(rows_.size(), MakeUnilateralRow());
+  for (int c = 0; c < size(); ++c) {
+    const ConstraintRow& row = rows_[c];
+    if (row.bilateral) pgs[c] = MakeBilateralRow(row.lo, row.hi);
+    if (row.friction_of == 0) continue;
+    // A friction pair on the Coulomb disk of its contact's normal row c - friction_of.
+    PgsRow& p = pgs[c];
+    p.kind = RowKind::kFriction;
+    p.cone = FrictionCone::kDisk;
+    p.normal = c - row.friction_of;
+    p.partner = row.friction_of == 1 ? c + 1 : c - 1;
+    p.lo = -std::numeric_limits<double>::infinity();
+    p.mu = row.mu;
+  }
 }
 
 void IslandRows::Store(const VecX& lambda, KeyedMultipliers& to) const {

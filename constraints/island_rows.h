@@ -8,6 +8,7 @@
 
 #include "constraints/constraint_row.h"
 #include "constraints/island_body.h"
+#include "constraints/pgs_solver.h"
 #include "constraints/step_stats.h"
 
 namespace taut {
@@ -43,6 +44,9 @@ class IslandRows {
   int SetLookAheadRows(const IslandRows& from, int num_kept,
                        const std::vector<std::uint64_t>& sticky, double h,
                        const std::vector<VecX>& v, const std::vector<VecX>& v_from);
+  // pgs <- the PGS rows of these rows (both PGS users: the dual path's QPs, frozen islands):
+  // unilateral, bilateral with bounds, friction pairs on the Coulomb disk of their normal row.
+  void CalcPgsRows(std::vector<PgsRow>& pgs) const;
   // Row counts by type into stats (rows_strain, ...).
   void CountTypes(StepStats& stats) const;
   // J v of a row for per-body velocities v.

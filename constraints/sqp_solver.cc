@@ -75,23 +75,6 @@ double SqpSolver::CalcMerit(double h, const std::vector<IslandBody*>& bodies,
          rho * CalcViolationSum(h, bodies, sources, v) / h;
 }
 
-void SqpSolver::BuildPgsRows() {
-  // Unilateral rows, and friction pairs on the Coulomb disk of their contact's normal row.
-  pgs_rows_.assign(rows_.size(), MakeUnilateralRow());
-  for (int c = 0; c < rows_.size(); ++c) {
-    const ConstraintRow& row = rows_[c];
-    if (row.bilateral) pgs_rows_[c] = MakeBilateralRow(row.lo, row.hi);
-    if (row.friction_of == 0) continue;
-    PgsRow& p = pgs_rows_[c];
-    p.kind = RowKind::kFriction;
-    p.cone = FrictionCone::kDisk;
-    p.normal = static_cast<int>(c) - row.friction_of;
-    p.partner = row.friction_of == 1 ? static_cast<int>(c) + 1 : static_cast<int>(c) - 1;
-    p.lo = -std::numeric_limits<double>::infinity();
-    p.mu = row.mu;
-  }
-}
-
 KktResiduals SqpSolver::CalcFullStepCertificate(double h, const std::vector<IslandBody*>& bodies,
                                                 const std::vector<ConstraintSource*>& sources,
                                                 const SqpSettings& settings, StepStats& stats) {
@@ -242,7 +225,7 @@ void SqpSolver::BuildQp(double h, const std::vector<IslandBody*>& bodies, bool r
     // Friction rows: w_t = J_t v = J_t (v* + Y lambda), so q = J_t v* (restoration: 0).
     if (row.friction_of > 0) q_[c] = restoring ? 0.0 : jdv + rows_.CalcRowVelocity(c, v_k_);
   }
-  BuildPgsRows();
+  rows_.CalcPgsRows(pgs_rows_);
   if (restoring) {
     lambda_qp_.setZero(m);
   } else {
@@ -280,22 +263,18 @@ bool SqpSolver::AddRowsViolatedAtQpStep(double h, const std::vector<IslandBody*>
   const auto t_rows = std::chrono::steady_clock::now();
   full_violation_ = full_rows_.Collect(h, bodies, sources, v_qp_, distance_scale);
   full_rows_at_v_qp_ = true;
-  const int had = rows_.size();
-  const int look_ahead =
-      rows_.SetLookAheadRows(full_rows_, num_collected_, look_ahead_keys_, h, v_k_, v_qp_);
+  rows_.SetLookAheadRows(full_rows_, num_collected_, look_ahead_keys_, h, v_k_, v_qp_);
   stats.ms_rows += MsSince(t_rows);
-  // Done when no row joined: the same look-ahead rows, relinearized at this v_QP.
-  if (rows_.size() == had && look_ahead == had - num_collected_) {
-    bool same = true;
-    for (int c = num_collected_; c < rows_.size() && same; ++c)
-      same = std::binary_search(look_ahead_keys_.begin(), look_ahead_keys_.end(), rows_[c].key);
-    if (same) return false;
-  }
+  // Done when the look-ahead rows are the ones the QP had (now relinearized at this v_QP).
+  next_look_ahead_keys_.clear();
+  for (int c = num_collected_; c < rows_.size(); ++c) next_look_ahead_keys_.push_back(rows_[c].key);
+  std::sort(next_look_ahead_keys_.begin(), next_look_ahead_keys_.end());
+  if (next_look_ahead_keys_ == look_ahead_keys_) return false;
+  for (const std::uint64_t key : next_look_ahead_keys_)
+    if (!std::binary_search(look_ahead_keys_.begin(), look_ahead_keys_.end(), key))
+      ++stats.rows_discovered;
+  std::swap(look_ahead_keys_, next_look_ahead_keys_);
   full_rows_at_v_qp_ = false;  // the QP is solved again: a new v_QP
-  look_ahead_keys_.clear();
-  for (int c = num_collected_; c < rows_.size(); ++c) look_ahead_keys_.push_back(rows_[c].key);
-  std::sort(look_ahead_keys_.begin(), look_ahead_keys_.end());
-  stats.rows_discovered += rows_.size() - had;
   // Look-ahead rows start from 0 (the collected keep lambda_k).
   lambda_.conservativeResize(rows_.size());
   lambda_.tail(rows_.size() - num_collected_).setZero();

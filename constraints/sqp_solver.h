@@ -2,6 +2,7 @@
 // (docs/math.md §5.7). Shared by every row type.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "constraints/active_set_polish.h"
@@ -81,8 +82,6 @@ class SqpSolver {
   double CalcMerit(double h, const std::vector<IslandBody*>& bodies,
                    const std::vector<ConstraintSource*>& sources, const std::vector<VecX>& v,
                    double rho);
-  // PGS row descriptions of rows_ (unilateral, or friction on the disk of its normal row).
-  void BuildPgsRows();
   // The certificate of the full QP step (v_QP, lambda_QP) at its own rows (collected at
   // x_k + h v_QP, the multipliers matched by key).
   KktResiduals CalcFullStepCertificate(double h, const std::vector<IslandBody*>& bodies,
@@ -103,13 +102,14 @@ class SqpSolver {
   VecX q_, lambda_, lambda_qp_, w_;
   int num_collected_ = 0;                       // rows_ collected at v_k; look-ahead rows follow
   std::vector<std::uint64_t> look_ahead_keys_;  // their keys, sorted
-  IslandRows full_rows_;                        // rows at the full QP step
-  double full_violation_ = 0.0;                 // their largest violation (IslandRows::Collect)
-  bool full_rows_at_v_k_ = false;               // a full step was taken: full_rows_ are v_k's rows
-  bool full_rows_at_v_qp_ = false;              // full_rows_ were collected at the current v_QP
-  VecX full_lambda_;                            // lambda_QP on full_rows_
-  KeyedMultipliers qp_keyed_;                   // lambda_QP by key
-  Eigen::RowVectorXd w_row_;                    // one row of W being assembled
+  std::vector<std::uint64_t> next_look_ahead_keys_;  // the next pass's (scratch)
+  IslandRows full_rows_;                             // rows at the full QP step
+  double full_violation_ = 0.0;     // their largest violation (IslandRows::Collect)
+  bool full_rows_at_v_k_ = false;   // a full step was taken: full_rows_ are v_k's rows
+  bool full_rows_at_v_qp_ = false;  // full_rows_ were collected at the current v_QP
+  VecX full_lambda_;                // lambda_QP on full_rows_
+  KeyedMultipliers qp_keyed_;       // lambda_QP by key
+  Eigen::RowVectorXd w_row_;        // one row of W being assembled
   std::vector<VecX> v_k_, v_qp_, v_trial_, dv_;
   VecX scratch_, jt_;          // 3N work vectors (A dv, J^T lambda), reused across steps
   KeyedMultipliers previous_;  // last step's multipliers by key

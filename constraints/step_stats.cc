@@ -33,20 +33,26 @@ int StepStats::rows_total() const {
 
 namespace {
 
-// total += part for the constraint work that adds up over islands and over substeps.
-void AddWork(const StepStats& part, StepStats& total) {
+// total += part for the solver's iteration work (time, sweeps, iterations, factorizations): what a
+// solve costs, whether its answer is kept or dropped.
+void AddSolveIterations(const StepStats& part, StepStats& total) {
   total.ms_rows += part.ms_rows;
   total.ms_solve += part.ms_solve;
-  for (const RowTypeInfo& info : kRowTypes) total.rows_of(info.type) += part.rows_of(info.type);
   total.pgs_sweeps += part.pgs_sweeps;
   total.restoration_iterations += part.restoration_iterations;
   total.active_set_solves += part.active_set_solves;
   total.rows_discovered += part.rows_discovered;
-  total.islands_dual += part.islands_dual;
-  total.islands_primal += part.islands_primal;
   total.newton_iterations += part.newton_iterations;
   total.pcg_iterations += part.pcg_iterations;
   total.newton_factorizations += part.newton_factorizations;
+}
+
+// total += part for the constraint work that adds up over islands and over substeps.
+void AddWork(const StepStats& part, StepStats& total) {
+  AddSolveIterations(part, total);
+  for (const RowTypeInfo& info : kRowTypes) total.rows_of(info.type) += part.rows_of(info.type);
+  total.islands_dual += part.islands_dual;
+  total.islands_primal += part.islands_primal;
   total.islands_retried += part.islands_retried;
 }
 
@@ -96,16 +102,8 @@ void AddIslandStats(const StepStats& island, StepStats& step) {
 }
 
 void AddDroppedSolveWork(const StepStats& dropped, StepStats& kept) {
-  kept.ms_rows += dropped.ms_rows;
-  kept.ms_solve += dropped.ms_solve;
-  kept.pgs_sweeps += dropped.pgs_sweeps;
+  AddSolveIterations(dropped, kept);
   kept.sqp_iterations += dropped.sqp_iterations;
-  kept.restoration_iterations += dropped.restoration_iterations;
-  kept.active_set_solves += dropped.active_set_solves;
-  kept.rows_discovered += dropped.rows_discovered;
-  kept.newton_iterations += dropped.newton_iterations;
-  kept.pcg_iterations += dropped.pcg_iterations;
-  kept.newton_factorizations += dropped.newton_factorizations;
 }
 
 void AddSubstepStats(const StepStats& substep, StepStats& call) {
