@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "constraints/limit_multiplier_refit.h"
+
 namespace taut {
 
 double KktResiduals::max_primal() const { return *std::max_element(primal.begin(), primal.end()); }
@@ -95,6 +97,26 @@ KktResiduals CalcKktResiduals(const std::vector<IslandBody*>& bodies, const Isla
   }
   kkt.dual = lambda_scale > 0.0 ? std::max(0.0, dual) / lambda_scale : 0.0;
   kkt.stationarity = CalcStationarity(bodies, rows, lambda, v, scratch);
+  return kkt;
+}
+
+KktResiduals CalcKktResidualsWithRefit(const std::vector<IslandBody*>& bodies,
+                                       const IslandRows& rows, const VecX& lambda,
+                                       const std::vector<VecX>& v, double h, double distance_scale,
+                                       double violation_tolerance, double stationarity_tolerance,
+                                       VecX& scratch, VecX& certified) {
+  certified = lambda;
+  const KktResiduals kkt = CalcKktResiduals(bodies, rows, lambda, v, h, distance_scale, scratch);
+  if (IsCertified(kkt, violation_tolerance, stationarity_tolerance) ||
+      kkt.max_primal() > violation_tolerance || kkt.dual > 1e-6)
+    return kkt;
+  // Aim below the tolerance: the refit stops once stationarity is surely within half of it.
+  RefitLimitMultipliers(bodies, rows, v, violation_tolerance, 0.5 * stationarity_tolerance,
+                        kRefitSweeps, certified);
+  const KktResiduals kkt_refit =
+      CalcKktResiduals(bodies, rows, certified, v, h, distance_scale, scratch);
+  if (IsCertified(kkt_refit, violation_tolerance, stationarity_tolerance)) return kkt_refit;
+  certified = lambda;
   return kkt;
 }
 

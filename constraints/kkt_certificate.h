@@ -35,6 +35,20 @@ KktResiduals CalcKktResiduals(const std::vector<IslandBody*>& bodies, const Isla
                               const VecX& lambda, const std::vector<VecX>& v, double h,
                               double distance_scale, VecX& scratch);
 
+// The residuals of (v, lambda), or, when v is primal and lambda dual feasible but the pair fails
+// the certificate (complementarity or stationarity), those of (v, lambda_fit) if they pass, with
+// lambda_fit the limit rows' least-squares multipliers at v (constraints/limit_multiplier_refit.h):
+// the certificate asks only that SOME multipliers satisfy the KKT conditions with v. `certified`
+// <- the multipliers whose residuals are returned (the forces a solver reports); the solvers keep
+// their own lambda for warm starts (docs/math.md §5.10, refitted multipliers).
+KktResiduals CalcKktResidualsWithRefit(const std::vector<IslandBody*>& bodies,
+                                       const IslandRows& rows, const VecX& lambda,
+                                       const std::vector<VecX>& v, double h, double distance_scale,
+                                       double violation_tolerance, double stationarity_tolerance,
+                                       VecX& scratch, VecX& certified);
+// Sweeps of that refit (a sweep costs about one pass over the rows' Jacobians).
+inline constexpr int kRefitSweeps = 50;
+
 // The certificate's residual as one number: the larger of max(primal, complementarity) over the
 // violation tolerance and the stationarity over its tolerance (<= 1: primal, complementarity and
 // stationarity certified).

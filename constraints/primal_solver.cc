@@ -572,7 +572,9 @@ bool PrimalSolver::IsNewtonIterateCertified(const std::vector<IslandBody*>& bodi
   // stopped at the tolerance crept 15 mm in 2 s where the exact solve holds it.
   CalcProjectedMultipliers();
   const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
-  newton_kkt_ = CalcKktResiduals(bodies, rows_, lambda_, v_, h, distance_scale, scratch_);
+  newton_kkt_ = CalcKktResidualsWithRefit(
+      bodies, rows_, lambda_, v_, h, distance_scale, settings.violation_tolerance,
+      settings.stationarity_tolerance, scratch_, newton_reported_);
   const KktResiduals& kkt = newton_kkt_;
   if (!IsCertified(kkt, settings.violation_tolerance, settings.stationarity_tolerance))
     return false;
@@ -672,9 +674,13 @@ void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     const double ms_rows_before = stats.ms_rows;  // row collection inside is ms_rows, not ms_solve
     // After a Newton stop on the certificate, lambda_bar = Proj(y(v)) at the same rows: its
     // residuals are the ones just computed.
-    const KktResiduals kkt = newton_certified_ ? newton_kkt_
-                                               : CalcKktResiduals(bodies, rows_, lambda_bar_, v_, h,
-                                                                  distance_scale, scratch_);
+    if (newton_certified_) reported_ = newton_reported_;
+    const KktResiduals kkt =
+        newton_certified_
+            ? newton_kkt_
+            : CalcKktResidualsWithRefit(bodies, rows_, lambda_bar_, v_, h, distance_scale,
+                                        settings.violation_tolerance,
+                                        settings.stationarity_tolerance, scratch_, reported_);
     newton_certified_ = false;
     RecordKkt(kkt, stats);
     stats.converged =
@@ -699,7 +705,10 @@ void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     stats.sqp_iterations = k + 1;
     stats.ms_solve += MsSince(t) - (stats.ms_rows - ms_rows_before);
   }
-  if (rows_.empty()) iterate_.clear();
+  if (rows_.empty()) {
+    iterate_.clear();
+    reported_.resize(0);
+  }
   for (size_t b = 0; b < nb; ++b) bodies[b]->set_v(v_[b]);
   stats.violation_after = violation_;  // of the rows kept (a restored base point's, not a trial's)
   warm = iterate_;

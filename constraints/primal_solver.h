@@ -41,10 +41,11 @@ class PrimalSolver {
   void Solve(double h, const std::vector<IslandBody*>& bodies,
              const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
              KeyedMultipliers& warm, StepStats& stats);
-  // The rows of the last Solve at its final velocities and their multipliers lambda_bar (one per
-  // row; contact rows: impulses [N s]). Read-only: forces out.
+  // The rows of the last Solve at its final velocities and their multipliers (one per row;
+  // contact rows: impulses [N s]): lambda_bar, or the refitted multipliers that certified the
+  // step (CalcKktResidualsWithRefit). Read-only: forces out.
   const IslandRows& rows() const { return rows_; }
-  const VecX& multipliers() const { return lambda_bar_; }
+  const VecX& multipliers() const { return reported_; }
 
  private:
   // Stage: rows, C and J at v (into rows_), lambda_bar by key, penalties, linearization.
@@ -119,6 +120,8 @@ class PrimalSolver {
   IslandRows rows_;
   KeyedMultipliers iterate_;   // lambda_bar of this step by key
   VecX lambda_bar_, lambda_;   // estimates, and Proj(y(v)) at the Newton iterate
+  VecX reported_;              // the multipliers of the last certificate (multipliers())
+  VecX newton_reported_;       // ... of the Newton loop's certificate
   VecX rho_, g0_, jv_, s_;     // penalties, g_c(v) = g0 + J v, J v, J d
   KeyedMultipliers kept_rho_;  // limit rows' rho of this multiplier iteration by key
   bool rho_kept_ = false;

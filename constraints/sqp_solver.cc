@@ -127,11 +127,13 @@ void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     rows_.WarmStart(iterate_, lambda_);
     if (rows_.empty()) {
       lambda_.resize(0);
+      reported_.resize(0);
       break;  // nothing active: no LCP at all
     }
     // Certificate of the iterate (constraints/kkt_certificate.h).
-    const KktResiduals kkt =
-        CalcKktResiduals(bodies, rows_, lambda_, v_k_, h, distance_scale, scratch_);
+    const KktResiduals kkt = CalcKktResidualsWithRefit(
+        bodies, rows_, lambda_, v_k_, h, distance_scale, settings.violation_tolerance,
+        settings.stationarity_tolerance, scratch_, reported_);
     RecordKkt(kkt, stats);
     const double stationarity = kkt.stationarity;
     const bool force_free = lambda_.cwiseAbs().maxCoeff() == 0.0;

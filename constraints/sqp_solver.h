@@ -38,9 +38,10 @@ class SqpSolver {
   // Last step's multipliers by row key (shared with the primal path by IslandSolver).
   KeyedMultipliers& mutable_warm_starts() { return previous_; }
   // The rows of the last Solve, collected at its final velocities, and their multipliers (one per
-  // row, the total multiplier lambda_k; contact rows: impulses [N s]). Read-only: forces out.
+  // row, the total multiplier lambda_k, or the refitted multipliers that certified the step:
+  // CalcKktResidualsWithRefit; contact rows: impulses [N s]). Read-only: forces out.
   const IslandRows& rows() const { return rows_; }
-  const VecX& multipliers() const { return lambda_; }
+  const VecX& multipliers() const { return reported_; }
 
  private:
   // Positions x_b of every body at velocities v (into x_).
@@ -100,8 +101,9 @@ class SqpSolver {
   std::vector<VecX> x_;      // (num_bodies) positions at a trial velocity
   MatX W_;
   VecX q_, lambda_, lambda_qp_, w_;
-  int num_collected_ = 0;                       // rows_ collected at v_k; look-ahead rows follow
-  std::vector<std::uint64_t> look_ahead_keys_;  // their keys, sorted
+  VecX reported_;          // the multipliers of the last certificate (multipliers())
+  int num_collected_ = 0;  // rows_ collected at v_k; look-ahead rows follow
+  std::vector<std::uint64_t> look_ahead_keys_;       // their keys, sorted
   std::vector<std::uint64_t> next_look_ahead_keys_;  // the next pass's (scratch)
   IslandRows full_rows_;                             // rows at the full QP step
   double full_violation_ = 0.0;     // their largest violation (IslandRows::Collect)

@@ -1,0 +1,181 @@
+// The limit rows' least-squares multipliers (constraints/limit_multiplier_refit.h) and the
+// certificate that uses them (CalcKktResidualsWithRefit, docs/math.md §5.10): with redundant rows
+// the force may sit on a row short of its bound while another row at its bound could carry it;
+// the certificate then holds for the refitted multipliers. A slack row that alone holds the body
+// is not released into a certificate.
+#include "constraints/limit_multiplier_refit.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "constraints/kkt_certificate.h"
+
+namespace taut {
+namespace {
+
+constexpr double kRefitH = 0.01;
+constexpr double kRefitTolerance = 1e-3;
+
+// Point masses (one 3-vector block each, A = m I) with a target velocity v*.
+class RefitPointMasses final : public IslandBody {
+ public:
+  RefitPointMasses(int n, double mass) : mass_(mass), v_star_(VecX::Zero(3 * n)), v_(v_star_) {}
+  void set_v_star(const VecX& v_star) { v_star_ = v_star; }
+  int num_blocks() const override { return static_cast<int>(v_.size() / 3); }
+  const VecX& v_star() const override { return v_star_; }
+  const VecX& v() const override { return v_; }
+  void set_v(const VecX& v) override { v_ = v; }
+  void SolveSystemColumns(Eigen::Ref<MatX> columns) const override { columns /= mass_; }
+  void ApplySystemMatrix(const VecX& v, VecX& out) const override { out = mass_ * v; }
+  bool is_free_block(int) const override { return true; }
+  void CalcPositions(double h, const VecX& v, VecX& x) const override { x = h * v; }
+  double CalcBlockMobility(int, const Vec3& J) const override { return J.squaredNorm() / mass_; }
+  void ResetNewtonMatrix() override {}
+  bool IsInNewtonPattern(int, int) const override { return true; }
+  void AddNewtonBlock(int, int, const Mat3&) override {}
+  void FactorNewtonMatrix() override {}
+  void SolveNewton(Eigen::Ref<VecX> rhs) const override { rhs /= mass_; }
+  void ApplyNewtonMatrix(const VecX& v, VecX& out) const override { out = mass_ * v; }
+
+ private:
+  double mass_;
+  VecX v_star_, v_;
+};
+
+// Unilateral limit rows with given C and one Jacobian entry per block.
+struct RefitGivenRow {
+  double C;
+  std::vector<std::pair<int, Vec3>> entries;  // (block, J)
+};
+
+class RefitGivenRows final : public ConstraintSource {
+ public:
+  explicit RefitGivenRows(std::vector<RefitGivenRow> rows) : rows_(std::move(rows)) {}
+  int AppendIslandRows(const IslandIterate&, std::vector<ConstraintRow>& rows) override {
+    for (size_t r = 0; r < rows_.size(); ++r) {
+      ConstraintRow& row = rows.emplace_back();
+      row.type = RowType::kStrainLimit;
+      row.key = r;
+      row.C = rows_[r].C;
+      row.body = 0;
+      row.num_nodes = static_cast<int>(rows_[r].entries.size());
+      for (int n = 0; n < row.num_nodes; ++n) {
+        row.nodes[n] = rows_[r].entries[n].first;
+        row.J[n] = rows_[r].entries[n].second;
+      }
+    }
+    return static_cast<int>(rows_.size());
+  }
+  double CalcIslandViolationSum(const IslandIterate&) const override { return 0.0; }
+
+ private:
+  std::vector<RefitGivenRow> rows_;
+};
+
+struct RefitIsland {
+  RefitPointMasses body;
+  RefitGivenRows source;
+  std::vector<IslandBody*> bodies{&body};
+  IslandRows rows;
+  std::vector<VecX> v;
+  RefitIsland(int n, double mass, std::vector<RefitGivenRow> given)
+      : body(n, mass), source(std::move(given)) {
+    v = {VecX::Zero(3 * n)};
+    std::vector<ConstraintSource*> sources{&source};
+    rows.Collect(kRefitH, bodies, sources, v, 1.0);
+  }
+  KktResiduals Residuals(const VecX& lambda) {
+    VecX scratch;
+    return CalcKktResiduals(bodies, rows, lambda, v, kRefitH, 1.0, scratch);
+  }
+  KktResiduals ResidualsWithRefit(const VecX& lambda, VecX& certified) {
+    VecX scratch;
+    return CalcKktResidualsWithRefit(bodies, rows, lambda, v, kRefitH, 1.0, kRefitTolerance, 1e-2,
+                                     scratch, certified);
+  }
+};
+
+// A 2 kg mass at rest (v = 0) whose target velocity v* = (0, 0, -1) is held by two rows along +z:
+// row 0 at its bound (C = 0), row 1 short of it (C = 5e-3). The force A (v - v*) = (0, 0, 2)
+// split 30/70 (what an augmented-Lagrangian iterate may carry) violates complementarity on row 1.
+TEST(LimitMultiplierRefitTest, ForceOnARowShortOfItsBoundMovesToTheRowAtItsBound) {
+  RefitIsland island(1, 2.0, {{0.0, {{0, Vec3(0, 0, 1)}}}, {5e-3, {{0, Vec3(0, 0, 1)}}}});
+  island.body.set_v_star(Vec3(0, 0, -1));
+  const VecX split = (VecX(2) << 0.6, 1.4).finished();
+  const KktResiduals first = island.Residuals(split);
+  EXPECT_LT(first.stationarity, 1e-12);
+  EXPECT_NEAR(first.max_complementarity(), 5e-3, 1e-15);
+  EXPECT_FALSE(IsCertified(first, kRefitTolerance, 1e-2));
+
+  VecX fit = split;
+  RefitLimitMultipliers(island.bodies, island.rows, island.v, kRefitTolerance, 0.0, 100, fit);
+  EXPECT_EQ(fit[1], 0.0);           // released: C > tolerance
+  EXPECT_NEAR(fit[0], 2.0, 1e-12);  // the whole force on the row at its bound
+  VecX certified;
+  const KktResiduals refit = island.ResidualsWithRefit(split, certified);
+  EXPECT_TRUE(IsCertified(refit, kRefitTolerance, 1e-2));
+  EXPECT_EQ(refit.max_complementarity(), 0.0);
+  EXPECT_EQ(certified, fit);  // the multipliers that passed, for the solver to report
+}
+
+// The same mass held only by the slack row along +z; the row at its bound points along +x and
+// cannot carry the force. Releasing the slack row leaves A (v - v*) unbalanced: v is not a KKT
+// point and the certificate keeps failing with the first residuals.
+TEST(LimitMultiplierRefitTest, ASlackRowThatAloneHoldsTheBodyIsNotReleasedIntoACertificate) {
+  RefitIsland island(1, 2.0, {{0.0, {{0, Vec3(1, 0, 0)}}}, {5e-3, {{0, Vec3(0, 0, 1)}}}});
+  island.body.set_v_star(Vec3(0, 0, -1));
+  const VecX lambda = (VecX(2) << 0.0, 2.0).finished();
+  VecX certified;
+  const KktResiduals refit = island.ResidualsWithRefit(lambda, certified);
+  EXPECT_FALSE(IsCertified(refit, kRefitTolerance, 1e-2));
+  EXPECT_EQ(certified, lambda);  // nothing passed: the solver's own multipliers stay
+  EXPECT_NEAR(refit.max_complementarity(), 5e-3, 1e-15);
+  EXPECT_LT(refit.stationarity, 1e-12);
+
+  VecX fit = lambda;
+  RefitLimitMultipliers(island.bodies, island.rows, island.v, kRefitTolerance, 0.0, 100, fit);
+  EXPECT_EQ(fit[1], 0.0);
+  EXPECT_EQ(fit[0], 0.0);  // +x cannot push against -z: the projection keeps it at 0
+}
+
+// Random redundant rows (12 rows on 2 masses, 6 DOFs): the refit is the nonnegative least-squares
+// solution, checked by its optimality conditions: with r = A (v - v*) - J^T lambda, J_c . r = 0
+// on rows that push and <= 0 on active rows at 0; slack rows are released.
+TEST(LimitMultiplierRefitTest, RefitSatisfiesTheNonnegativeLeastSquaresOptimality) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::vector<RefitGivenRow> given;
+  for (int r = 0; r < 12; ++r) {
+    const double C = r % 3 == 0 ? 4e-3 : 0.5 * kRefitTolerance * unit(rng);
+    given.push_back(
+        {C,
+         {{0, Vec3(unit(rng), unit(rng), unit(rng))}, {1, Vec3(unit(rng), unit(rng), unit(rng))}}});
+  }
+  RefitIsland island(2, 1.5, given);
+  island.body.set_v_star((VecX(6) << 0.3, -0.2, -1.0, 0.1, 0.4, -0.7).finished());
+  VecX fit = VecX::Constant(12, 0.5);
+  RefitLimitMultipliers(island.bodies, island.rows, island.v, kRefitTolerance, 0.0, 100000, fit);
+
+  VecX r = 1.5 * (island.v[0] - island.body.v_star());
+  for (int c = 0; c < 12; ++c)
+    island.rows[c].ForEachEntry(
+        [&](int, int block, const Vec3& J) { r.segment<3>(3 * block) -= fit[c] * J; });
+  const double scale = (1.5 * island.body.v_star()).norm();
+  for (int c = 0; c < 12; ++c) {
+    double jr = 0.0;
+    island.rows[c].ForEachEntry(
+        [&](int, int block, const Vec3& J) { jr += J.dot(r.segment<3>(3 * block)); });
+    EXPECT_GE(fit[c], 0.0) << "row " << c;
+    if (island.rows[c].C > kRefitTolerance) {
+      EXPECT_EQ(fit[c], 0.0) << "slack row " << c;
+    } else if (fit[c] > 0.0) {
+      EXPECT_NEAR(jr, 0.0, 1e-8 * scale) << "pushing row " << c;
+    } else {
+      EXPECT_LE(jr, 1e-8 * scale) << "active row at 0, " << c;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace taut
