@@ -26,6 +26,11 @@ cmake "${generator[@]}" -S "${TAUT_ROOT}" -B "${build_dir}" -DCMAKE_BUILD_TYPE=R
 taut_stage "Building taut-report (-j${TAUT_JOBS})"
 cmake --build "${build_dir}" -j"${TAUT_JOBS}" --target taut-report
 
+# The armadillo scene reads data/armadillo.off (Debian's libcgal-demo); without it the report says
+# "not measured" for that scene.
+taut_stage "Fetching the armadillo (scripts/fetch_armadillo.sh)"
+bash scripts/fetch_armadillo.sh || echo "warning: armadillo download failed; the report skips it" >&2
+
 report="${build_dir}/demos/taut-report"
 taut_stage "Running ${report} --out docs/report $*"
 start=${SECONDS}
