@@ -59,7 +59,11 @@ void RefitLimitMultipliers(const std::vector<IslandBody*>& bodies, const IslandR
   for (size_t b = 0; b < nb; ++b) residual += r[b].squaredNorm();
   // Stationarity is ||r|| over max(||J^T lambda||, ||A (v - v*)||) >= ||r|| / ||A (v - v*)||.
   const double target = target_stationarity * target_stationarity * momentum;
+  // A refit whose residual, falling at its last sweep's rate over the sweeps left, would still be
+  // above (2 target_stationarity)^2 ||A (v - v*)||^2 cannot certify: stop (a stall).
+  const double give_up = 16.0 * target;
   for (int sweep = 0; sweep < max_sweeps && residual > target; ++sweep) {
+    const double residual_before = residual;
     double largest_change = 0.0;
     for (size_t a = 0; a < active.size(); ++a) {
       if (!(diagonal[a] > 0.0)) continue;
@@ -80,6 +84,8 @@ void RefitLimitMultipliers(const std::vector<IslandBody*>& bodies, const IslandR
     }
     const double scale = lambda.size() > 0 ? lambda.cwiseAbs().maxCoeff() : 0.0;
     if (largest_change <= 1e-9 * scale) break;
+    const double rate = residual_before > 0.0 ? residual / residual_before : 0.0;
+    if (give_up > 0.0 && residual * std::pow(rate, max_sweeps - sweep - 1) > give_up) break;
   }
 }
 

@@ -17,8 +17,10 @@ namespace taut {
 // tolerance), o = every other row with its lambda kept, except slack unilateral limit rows
 // (C > violation_tolerance), whose lambda becomes 0. Projected coordinate descent (Gauss-Seidel
 // on J_a J_a^T) from lambda, at most `max_sweeps` sweeps; stops when the residual is below
-// target_stationarity ||A (v - v*)|| (stationarity is then at most target_stationarity) or a
-// sweep changes no multiplier by more than 1e-9 of the largest.
+// target_stationarity ||A (v - v*)|| (stationarity is then at most target_stationarity), when a
+// sweep changes no multiplier by more than 1e-9 of the largest, or when the residual, falling at
+// the last sweep's rate over the sweeps left, would stay above 2 target_stationarity ||A (v - v*)||
+// (a stall: such a refit cannot certify).
 void RefitLimitMultipliers(const std::vector<IslandBody*>& bodies, const IslandRows& rows,
                            const std::vector<VecX>& v, double violation_tolerance,
                            double target_stationarity, int max_sweeps, VecX& lambda);
