@@ -12,7 +12,6 @@
 #include "plugin/common.h"
 
 namespace taut {
-bool SnapshotSkip(const char* part);
 
 namespace {
 
@@ -67,16 +66,13 @@ btVector3 UnscaleByFactor(const btVector3& total, const btVector3& factor) {
 }
 
 void RestoreRigidBody(const CollisionObjectState& state, btRigidBody& rigid) {
-  if (!SnapshotSkip("inertia"))
-    rigid.updateInertiaTensor();  // I_world^-1 of the restored transform, as after integration
+  rigid.updateInertiaTensor();  // I_world^-1 of the restored transform, as after integration
   rigid.setLinearVelocity(state.linear_velocity);
   rigid.setAngularVelocity(state.angular_velocity);
-  if (!SnapshotSkip("rforces")) {
-    rigid.clearForces();
-    rigid.applyCentralForce(UnscaleByFactor(state.total_force, rigid.getLinearFactor()));
-    rigid.applyTorque(UnscaleByFactor(state.total_torque, rigid.getAngularFactor()));
-  }
-  if (!SnapshotSkip("motion") && state.has_motion_state && rigid.getMotionState() != nullptr)
+  rigid.clearForces();
+  rigid.applyCentralForce(UnscaleByFactor(state.total_force, rigid.getLinearFactor()));
+  rigid.applyTorque(UnscaleByFactor(state.total_torque, rigid.getAngularFactor()));
+  if (state.has_motion_state && rigid.getMotionState() != nullptr)
     rigid.getMotionState()->setWorldTransform(state.motion_state_transform);
 }
 
@@ -84,16 +80,12 @@ void RestoreObject(const CollisionObjectState& state, btCollisionObject& object,
                    btCollisionWorld& world) {
   const bool moved = !SameTransform(object.getWorldTransform(), state.world_transform);
   object.setWorldTransform(state.world_transform);
-  if (!SnapshotSkip("interp")) {
-    object.setInterpolationWorldTransform(state.interpolation_transform);
-    object.setInterpolationLinearVelocity(state.interpolation_linear_velocity);
-    object.setInterpolationAngularVelocity(state.interpolation_angular_velocity);
-  }
-  if (!SnapshotSkip("activation")) {
-    object.forceActivationState(state.activation_state);
-    object.setDeactivationTime(state.deactivation_time);
-  }
-  if (!SnapshotSkip("hitfraction")) object.setHitFraction(state.hit_fraction);
+  object.setInterpolationWorldTransform(state.interpolation_transform);
+  object.setInterpolationLinearVelocity(state.interpolation_linear_velocity);
+  object.setInterpolationAngularVelocity(state.interpolation_angular_velocity);
+  object.forceActivationState(state.activation_state);
+  object.setDeactivationTime(state.deactivation_time);
+  object.setHitFraction(state.hit_fraction);
   if (btRigidBody* rigid = btRigidBody::upcast(&object)) RestoreRigidBody(state, *rigid);
   // The next step refreshes the bounds of active objects only (unless forced for all).
   if (moved && !object.isActive() && object.getBroadphaseHandle() != nullptr)
@@ -157,7 +149,7 @@ void RestoreManifolds(const std::vector<ManifoldState>& saved, btDiscreteDynamic
   btDispatcher& dispatcher = *world.getDispatcher();
   const btCollisionObjectArray& objects = world.getCollisionObjectArray();
   std::vector<int> match = MatchManifolds(saved, dispatcher, objects);
-  if (!SnapshotSkip("detect") && MissesContacts(saved, match)) {
+  if (MissesContacts(saved, match)) {
     // Bullet makes the pairs and manifolds of the restored poses; their points are replaced.
     world.performDiscreteCollisionDetection();
     match = MatchManifolds(saved, dispatcher, objects);
@@ -166,17 +158,16 @@ void RestoreManifolds(const std::vector<ManifoldState>& saved, btDiscreteDynamic
   std::vector<char> matched(dispatcher.getNumManifolds(), 0);
   for (size_t s = 0; s < saved.size(); ++s) {
     if (match[s] < 0) continue;
-    if (!SnapshotSkip("points"))
-      WriteManifold(saved[s], *dispatcher.getManifoldByIndexInternal(match[s]));
+    WriteManifold(saved[s], *dispatcher.getManifoldByIndexInternal(match[s]));
     order.push_back(match[s]);
     matched[match[s]] = 1;
   }
   for (int m = 0; m < dispatcher.getNumManifolds(); ++m) {
     if (matched[m]) continue;
-    if (!SnapshotSkip("unmatched")) dispatcher.getManifoldByIndexInternal(m)->clearManifold();
+    dispatcher.getManifoldByIndexInternal(m)->clearManifold();
     order.push_back(m);
   }
-  if (!SnapshotSkip("order")) ReorderManifolds(order, dispatcher);
+  ReorderManifolds(order, dispatcher);
 }
 
 }  // namespace
@@ -247,7 +238,7 @@ void RestoreBulletWorldState(const BulletWorldState& state, btDiscreteDynamicsWo
     joint.setEnabled(state.joints[j].enabled);
     joint.internalSetAppliedImpulse(state.joints[j].applied_impulse);
   }
-  if (!SnapshotSkip("manifolds")) RestoreManifolds(state.manifolds, world);
+  RestoreManifolds(state.manifolds, world);
   if (state.has_solver_seed &&
       world.getConstraintSolver()->getSolverType() == BT_SEQUENTIAL_IMPULSE_SOLVER)
     static_cast<btSequentialImpulseConstraintSolver*>(world.getConstraintSolver())

@@ -2,17 +2,10 @@
 #include "bullet_bridge/world_snapshot.h"
 
 #include <algorithm>
-#include <cstdlib>
-#include <cstring>
 #include <unordered_map>
 
 #include "bullet_bridge/deformable_world.h"
 namespace taut {
-bool SnapshotSkip(const char* part) {
-  static const char* skip = std::getenv("TAUT_SNAPSHOT_SKIP");
-  return skip != nullptr && std::strstr(skip, part) != nullptr;
-}
-
 // The stages of a snapshot, with access to the world's entries.
 template <class BulletWorld>
 struct DeformableWorldOf<BulletWorld>::Snapshots {
@@ -137,28 +130,8 @@ void DeformableWorldOf<BulletWorld>::Snapshots::RestoreDeformables(DeformableWor
                                                                    const WorldSnapshot& snapshot) {
   for (size_t b = 0; b < world.bodies_.size(); ++b) {
     Entry& entry = *world.bodies_[b];
-    DeformableBody::State state = snapshot.deformables[b].body;
-    const DeformableBody::State current = entry.object->body().SaveState();
-    if (SnapshotSkip("external")) state.external = current.external;
-    if (SnapshotSkip("kinds")) {
-      state.kinds = current.kinds;
-      state.kinematic_targets = current.kinematic_targets;
-      state.kinds_changed = current.kinds_changed;
-      state.newton = current.newton;
-    }
-    if (SnapshotSkip("newton")) {
-      state.newton = current.newton;
-      if (current.kinds_changed) state.newton = {};
-    }
-    entry.object->body().RestoreState(state);
-    IslandSolver::State solver = snapshot.deformables[b].solver;
-    const IslandSolver::State solver_now = entry.solver.SaveState();
-    if (SnapshotSkip("warm")) solver.warm = solver_now.warm;
-    if (SnapshotSkip("pathrule")) {
-      solver.last_rows = solver_now.last_rows;
-      solver.primal_steps_left = solver_now.primal_steps_left;
-    }
-    entry.solver.RestoreState(solver);
+    entry.object->body().RestoreState(snapshot.deformables[b].body);
+    entry.solver.RestoreState(snapshot.deformables[b].solver);
   }
 }
 
@@ -247,10 +220,10 @@ void DeformableWorldOf<BulletWorld>::RestoreSnapshot(const WorldSnapshot& snapsh
   Snapshots::CheckDeformables(*this, snapshot);
   CheckBulletWorldState(snapshot.bullet, *this);
   Snapshots::RestoreDeformables(*this, snapshot);
-  if (!SnapshotSkip("ids")) Snapshots::RestoreSourceIds(*this, snapshot);
+  Snapshots::RestoreSourceIds(*this, snapshot);
   // After the deformables: Bullet's collision detection may run, and sees their restored bounds.
   RestoreBulletWorldState(snapshot.bullet, *this);
-  if (!SnapshotSkip("localtime")) this->m_localTime = snapshot.local_time;
+  this->m_localTime = snapshot.local_time;
   this->m_fixedTimeStep = snapshot.fixed_time_step;
   stats_ = snapshot.last_step_stats;
   call_stats_ = snapshot.last_call_stats;
