@@ -18,6 +18,7 @@ class DeformableIslandBody final : public IslandBody {
   void SolveSystemColumns(Eigen::Ref<MatX> columns) const override {
     body_->SolveSystemColumns(columns);
   }
+  void SolveSystemApproximately(VecX& rhs) const override { body_->SolveSystemApproximately(rhs); }
   void ApplySystemMatrix(const VecX& v, VecX& out) const override {
     body_->ApplySystemMatrix(v, out);
   }

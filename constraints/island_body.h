@@ -28,6 +28,8 @@ class IslandBody {
   virtual void set_v(const VecX& v) = 0;
   // columns <- A^-1 columns (zero on blocks that do not move freely).
   virtual void SolveSystemColumns(Eigen::Ref<MatX> columns) const = 0;
+  // rhs <- an approximation of A^-1 rhs, for starting guesses (default: exact).
+  virtual void SolveSystemApproximately(VecX& rhs) const { SolveSystemColumns(rhs); }
   // out = A v (zero on blocks that do not move freely).
   virtual void ApplySystemMatrix(const VecX& v, VecX& out) const = 0;
   // False for blocks pinned by the body itself (fixed or kinematic nodes).

@@ -588,7 +588,8 @@ bool PrimalSolver::IsNewtonIterateCertified(const std::vector<IslandBody*>& bodi
 }
 
 bool PrimalSolver::WarmStartVelocities(const std::vector<IslandBody*>& bodies) {
-  // v = v* + A^-1 J^T lambda_bar (the previous step's impulses on this step's rows).
+  // v = v* + A^-1 J^T lambda_bar (the previous step's impulses on this step's rows), with the
+  // factor the unconstrained solve held: only a candidate start, so a kept factor does.
   if (rows_.empty() || lambda_bar_.cwiseAbs().maxCoeff() == 0.0) return false;
   for (size_t b = 0; b < bodies.size(); ++b) work_[b].setZero();
   for (int c = 0; c < rows_.size(); ++c)
@@ -596,7 +597,7 @@ bool PrimalSolver::WarmStartVelocities(const std::vector<IslandBody*>& bodies) {
       work_[body].segment<3>(3 * block) += lambda_bar_[c] * J;
     });
   for (size_t b = 0; b < bodies.size(); ++b) {
-    bodies[b]->SolveSystemColumns(work_[b]);
+    bodies[b]->SolveSystemApproximately(work_[b]);
     v_trial_[b] = v_[b] + work_[b];
   }
   return true;

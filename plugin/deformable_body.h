@@ -99,6 +99,10 @@ class DeformableBody {
   void SolveSystem(Eigen::Ref<VecX> rhs);
   // Same for every column of a 3N x k matrix.
   void SolveSystemColumns(Eigen::Ref<MatX> rhs);
+  // rhs <- P^-1 rhs with the factor held (this step's A or a kept earlier one): an approximate
+  // A^-1 for starting guesses that leaves the next step free to reuse the factor
+  // (ImplicitSystem::SolveApproximately).
+  void SolveSystemApproximately(Eigen::Ref<VecX> rhs) { system_.SolveApproximately(rhs, name()); }
   // PCG iterations of the last unconstrained solve on a kept factor; 0 when it factored A.
   int last_pcg_iterations() const { return last_pcg_iterations_; }
   // out = A v with this step's system matrix (free DOFs; 0 on fixed/kinematic DOFs).

@@ -187,6 +187,12 @@ void ImplicitSystem::Solve(Eigen::Ref<VecX> rhs) const {
   SolveWith(ldlt_, cholmod_, rhs);
 }
 
+void ImplicitSystem::SolveApproximately(Eigen::Ref<VecX> rhs, const std::string& body) {
+  const bool kept = !use_cholmod_ && ldlt_.factorized();  // CHOLMOD's factor is never kept
+  if (!factor_current_ && !kept) Factor(body);
+  SolveWith(ldlt_, cholmod_, rhs);
+}
+
 void ImplicitSystem::SolveColumns(Eigen::Ref<MatX> rhs) const {
   const int n = num_free_dofs();
   if (columns_free_.rows() != n || columns_free_.cols() < rhs.cols())

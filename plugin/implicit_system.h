@@ -68,6 +68,10 @@ class ImplicitSystem {
   void Solve(Eigen::Ref<VecX> rhs) const;
   // Same for each column of rhs (3N x k).
   void SolveColumns(Eigen::Ref<MatX> rhs) const;
+  // rhs (3N) <- P^-1 rhs with the held factor P, this step's A or an earlier step's kept one: an
+  // approximate A^-1 for starting guesses, which does not make the next step factor A (unlike
+  // EnsureCurrentFactor). Factors A when no factor is held. Throws SimulationError like Factor.
+  void SolveApproximately(Eigen::Ref<VecX> rhs, const std::string& body);
 
   // out (3N) = A v on free DOFs (v read on free DOFs only), 0 on constrained DOFs.
   void Multiply(const VecX& v, VecX& out) const;
