@@ -106,8 +106,12 @@ void IslandSolver::RetryOn(IslandSolverKind other, double h, const std::vector<I
   KeyedMultipliers first_warm = std::move(warm_);
   const bool first_primal = solved_primal_;
   warm_ = std::move(warm_start);
+  SqpSettings capped = settings;
+  capped.max_iterations = std::min(settings.max_iterations, settings.retry_max_iterations);
+  capped.primal.max_iterations =
+      std::min(settings.primal.max_iterations, settings.retry_max_iterations);
   StepStats retry;
-  SolveOn(other, h, bodies, sources, settings, retry);
+  SolveOn(other, h, bodies, sources, capped, retry);
   if (retry.converged || CalcCertificateError(retry) < CalcCertificateError(stats)) {
     AddDroppedSolveWork(stats, retry);
     stats = retry;

@@ -68,7 +68,8 @@ class IslandSolver {
                  const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
                  StepStats& stats);
   // After a failed step (kAuto, retry_failed_step_on_other_path): the path `other` from the
-  // step's start velocities (start_v_) and warm starts `warm_start`; keeps the better answer.
+  // step's start velocities (start_v_) and warm starts `warm_start`, at most
+  // retry_max_iterations iterations; keeps the better answer.
   void RetryOn(IslandSolverKind other, double h, const std::vector<IslandBody*>& bodies,
                const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
                KeyedMultipliers warm_start, StepStats& stats);

@@ -83,6 +83,10 @@ struct SqpSettings {
   // start on the other path and keep whichever answer has the smaller residual (converged
   // first). Costs a second solve on failed steps only. Default true.
   bool retry_failed_step_on_other_path = true;
+  // The retried path's iteration cap (primal: multiplier iterations, dual: SQP iterations), when
+  // below its own. Retries that certify a step took 1 or 2 (box_on_sphere, hex_beam, gripper);
+  // an advance the finger's press had locked ran the primal path's 40 for nothing (65 ms).
+  int retry_max_iterations = 10;
 };
 
 }  // namespace taut

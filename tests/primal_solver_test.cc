@@ -9,6 +9,8 @@
 #include <BulletCollision/CollisionShapes/btStaticPlaneShape.h>
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include "bullet_bridge/eigen_bullet.h"
 #include "constraints/island_solver.h"
 #include "demos/scenes/bullet_world_holder.h"
@@ -297,6 +299,35 @@ TEST(PrimalSolverTest, RigidBoxOnASoftBlockComesToRest) {
   EXPECT_LT(std::abs(primal.z_2s - primal.z_1s), 1e-4);
   EXPECT_GT(primal.z_2s, 0.14);  // carried by the block, not sunk through it
   EXPECT_NEAR(primal.z_2s, dual.z_2s, 1e-3);
+}
+
+// A bar whose free end is driven out to 1.3x its length against +-1 % limits: no velocity meets
+// the limits. The first step takes the dual path (no rows were counted yet), which fails; the
+// retry on the primal path fails too and stops at SqpSettings::retry_max_iterations instead of
+// its own cap of 40 multiplier iterations.
+TEST(PrimalSolverTest, RetryOfAnInfeasibleStepStopsAtItsCap) {
+  int total[2] = {0, 0};
+  const int caps[2] = {40, 3};
+  for (int run = 0; run < 2; ++run) {
+    SaggingBar bar(IslandSolverKind::kAuto, 0.99, 1.01);
+    for (int i = 0; i < bar.body->num_nodes(); ++i) {
+      const Vec3 X = bar.body->node_position(i);
+      if (X.x() > 0.4 - 1e-9) bar.body->SetKinematicTarget(i, Vec3(1.3 * X.x(), X.y(), X.z()));
+    }
+    SqpSettings& settings = bar.holder.world.mutable_solver_settings();
+    settings.retry_max_iterations = caps[run];
+    bar.holder.world.stepSimulation(1.0 / 240.0, 1, 1.0 / 240.0);
+    const StepStats& stats = bar.holder.world.last_step_stats();
+    ASSERT_FALSE(stats.converged);
+    ASSERT_EQ(stats.islands_retried, 1);
+    // Both paths' iterations are counted: the dual path's (with restoration) plus the retry's.
+    const int dual_cap = settings.max_iterations + settings.max_restoration_iterations;
+    EXPECT_LE(stats.sqp_iterations, dual_cap + caps[run]);
+    total[run] = stats.sqp_iterations;
+  }
+  std::printf("iterations of the failed step: %d with the retry uncapped, %d capped at 3\n",
+              total[0], total[1]);
+  EXPECT_GT(total[0], total[1] + 10) << "the uncapped retry ran further";
 }
 
 TEST(PrimalSolverTest, AutoChoiceFollowsRowsPerDof) {
