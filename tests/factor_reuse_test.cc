@@ -34,6 +34,26 @@ std::unique_ptr<DeformableBody> MakeReuseCantilever(bool reuse) {
 constexpr double kReuseStep = 1.0 / 240.0;
 const Vec3 kReuseGravity(0.0, 0.0, -9.81);
 
+// Steps the body three times and begins a fourth step, whose unconstrained solve reuses the kept
+// factor; false when the body factors with CHOLMOD (whose factors are never kept).
+bool BeginAStepOnTheKeptFactor(DeformableBody& body) {
+  for (int step = 0; step < 3; ++step) {
+    if (step == 1 && body.system().uses_cholmod()) return false;
+    body.BeginStep(kReuseStep, kReuseGravity);
+    body.EndStep(kReuseStep);
+  }
+  body.BeginStep(kReuseStep, kReuseGravity);
+  return true;
+}
+
+// A smooth right-hand side on the body's free DOFs, zero on the fixed ones.
+VecX MakeFreeDofRhs(const DeformableBody& body) {
+  VecX b = VecX::Zero(3 * body.num_nodes());
+  for (int i = 0; i < b.size(); ++i)
+    if (body.system().free_index(i) >= 0) b[i] = std::sin(0.37 * i);
+  return b;
+}
+
 TEST(FactorReuseTest, ReusingBodyFollowsTheFactoringBodyToTheCgTolerance) {
   auto reusing = MakeReuseCantilever(true);
   auto factoring = MakeReuseCantilever(false);
@@ -59,18 +79,11 @@ TEST(FactorReuseTest, ReusingBodyFollowsTheFactoringBodyToTheCgTolerance) {
 
 TEST(FactorReuseTest, ConstraintSolvesAfterAReusedStepApplyThisStepsInverse) {
   auto body = MakeReuseCantilever(true);
-  for (int step = 0; step < 3; ++step) {
-    if (step == 1 && body->system().uses_cholmod()) GTEST_SKIP() << "CHOLMOD is not reused";
-    body->BeginStep(kReuseStep, kReuseGravity);
-    body->EndStep(kReuseStep);
-  }
-  body->BeginStep(kReuseStep, kReuseGravity);
+  if (!BeginAStepOnTheKeptFactor(*body)) GTEST_SKIP() << "CHOLMOD is not reused";
   ASSERT_GT(body->last_pcg_iterations(), 0);
   ASSERT_FALSE(body->system().factor_is_current());
   // A (A^-1 b) = b on the free DOFs to round-off: the solve factored this step's A.
-  VecX b = VecX::Zero(3 * body->num_nodes());
-  for (int i = 0; i < b.size(); ++i)
-    if (body->system().free_index(i) >= 0) b[i] = std::sin(0.37 * i);
+  const VecX b = MakeFreeDofRhs(*body);
   VecX x = b;
   body->SolveSystem(x);
   EXPECT_TRUE(body->system().factor_is_current());
@@ -86,16 +99,9 @@ TEST(FactorReuseTest, ConstraintSolvesAfterAReusedStepApplyThisStepsInverse) {
 
 TEST(FactorReuseTest, ApproximateSolvesUseTheKeptFactorAndLeaveTheNextStepReusing) {
   auto body = MakeReuseCantilever(true);
-  for (int step = 0; step < 3; ++step) {
-    if (step == 1 && body->system().uses_cholmod()) GTEST_SKIP() << "CHOLMOD is not reused";
-    body->BeginStep(kReuseStep, kReuseGravity);
-    body->EndStep(kReuseStep);
-  }
-  body->BeginStep(kReuseStep, kReuseGravity);
+  if (!BeginAStepOnTheKeptFactor(*body)) GTEST_SKIP() << "CHOLMOD is not reused";
   ASSERT_GT(body->last_pcg_iterations(), 0);
-  VecX b = VecX::Zero(3 * body->num_nodes());
-  for (int i = 0; i < b.size(); ++i)
-    if (body->system().free_index(i) >= 0) b[i] = std::sin(0.37 * i);
+  const VecX b = MakeFreeDofRhs(*body);
   VecX approximate = b;
   body->SolveSystemApproximately(approximate);
   EXPECT_FALSE(body->system().factor_is_current()) << "no factorization of this step's A";
@@ -107,11 +113,7 @@ TEST(FactorReuseTest, ApproximateSolvesUseTheKeptFactorAndLeaveTheNextStepReusin
   EXPECT_LT(gap, 0.1 * exact.norm());
   // A fresh body whose only solve is the approximate one keeps reusing its factor.
   auto other = MakeReuseCantilever(true);
-  for (int step = 0; step < 4; ++step) {
-    other->BeginStep(kReuseStep, kReuseGravity);
-    other->EndStep(kReuseStep);
-  }
-  other->BeginStep(kReuseStep, kReuseGravity);
+  ASSERT_TRUE(BeginAStepOnTheKeptFactor(*other));
   ASSERT_GT(other->last_pcg_iterations(), 0);
   VecX y = b;
   other->SolveSystemApproximately(y);
