@@ -55,7 +55,10 @@ void IslandSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     for (size_t b = 0; b < bodies.size(); ++b) start_v_[b] = bodies[b]->v();
   }
   SolveOn(kind, h, bodies, sources, settings, stats);
-  if (retry && !stats.converged) {
+  // A dual step that stopped because no push lowers the violation is locally infeasible (the
+  // finger's locked advances): the primal retry failed there too, at three times the cost.
+  const bool infeasible = kind == IslandSolverKind::kDual && dual_.stalled_infeasible();
+  if (retry && !stats.converged && !infeasible) {
     const IslandSolverKind other =
         kind == IslandSolverKind::kPrimal ? IslandSolverKind::kDual : IslandSolverKind::kPrimal;
     RetryOn(other, h, bodies, sources, settings, std::move(warm_start), stats);

@@ -166,14 +166,22 @@ void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
       SolveQp(settings, stats);
       CalcQpVelocities(bodies, restoring);
     }
+    // No merit decrease along the QP step: the SQP cannot move v_k, so push-only restoration
+    // takes over (docs/math.md §5.7); when no push lowers the violation either, nothing can.
+    bool stuck = false;
     if (restoring) {
-      TakeRestorationStep(h, bodies, sources, settings, stats);
+      stuck = !TakeRestorationStep(h, bodies, sources, settings, stats);
     } else {
       last_alpha = TakeMeritStep(h, bodies, sources, settings, kkt, rho, stats);
+      restoring = last_alpha == 0.0;
     }
     rows_.Store(lambda_, iterate_);
     stats.sqp_iterations = k + 1;
     stats.ms_solve += MsSince(t_solve);
+    if (stuck) {
+      stalled_infeasible_ = true;
+      break;
+    }
   }
   for (size_t b = 0; b < bodies.size(); ++b) bodies[b]->set_v(v_k_[b]);
   rows_.Store(lambda_, previous_);
@@ -189,6 +197,7 @@ void SqpSolver::BeginSolve(const std::vector<IslandBody*>& bodies, const SqpSett
   dv_.resize(nb);
   for (size_t b = 0; b < nb; ++b) v_k_[b] = bodies[b]->v();
   columns_.Clear();  // this step's A
+  stalled_infeasible_ = false;
   if (settings.warm_start) {
     iterate_ = previous_;
   } else {
@@ -284,20 +293,23 @@ bool SqpSolver::AddRowsViolatedAtQpStep(double h, const std::vector<IslandBody*>
 }
 
 // Accepts the push only as far as it lowers the total violation (halving, as the merit).
-void SqpSolver::TakeRestorationStep(double h, const std::vector<IslandBody*>& bodies,
+bool SqpSolver::TakeRestorationStep(double h, const std::vector<IslandBody*>& bodies,
                                     const std::vector<ConstraintSource*>& sources,
                                     const SqpSettings& settings, StepStats& stats) {
   const size_t nb = bodies.size();
   const double before = CalcViolationSum(h, bodies, sources, v_k_);
   double alpha = 1.0;
-  for (int halving = 0; halving < settings.max_line_search_halvings; ++halving) {
+  bool lowered = false;
+  for (int halving = 0; halving <= settings.max_line_search_halvings && !lowered; ++halving) {
+    if (halving > 0) alpha *= 0.5;
     for (size_t b = 0; b < nb; ++b) v_trial_[b] = v_k_[b] + alpha * (v_qp_[b] - v_k_[b]);
-    if (CalcViolationSum(h, bodies, sources, v_trial_) < before) break;
-    alpha *= 0.5;
+    lowered = CalcViolationSum(h, bodies, sources, v_trial_) < before;
   }
+  stats.restoration_iterations++;
+  if (!lowered) return false;  // no push lowers the violation: v_k stays
   for (size_t b = 0; b < nb; ++b) v_k_[b] += alpha * (v_qp_[b] - v_k_[b]);
   lambda_ += alpha * lambda_qp_;
-  stats.restoration_iterations++;
+  return true;
 }
 
 // Merit backtracking from (v_k, lambda_k) towards (v_QP, lambda_QP), or the full step taken on its
@@ -314,16 +326,18 @@ double SqpSolver::TakeMeritStep(double h, const std::vector<IslandBody*>& bodies
   double alpha = 1.0;
   const double residual_k =
       CalcCertificateResidual(kkt, settings.violation_tolerance, settings.stationarity_tolerance);
-  bool certificate_step = false;
-  for (int halving = 0; halving < settings.max_line_search_halvings; ++halving) {
+  bool certificate_step = false, decreased = false;
+  for (int halving = 0; halving <= settings.max_line_search_halvings; ++halving) {
+    if (halving > 0) alpha *= 0.5;
     for (size_t b = 0; b < nb; ++b) v_trial_[b] = v_k_[b] + alpha * (v_qp_[b] - v_k_[b]);
-    if (CalcMerit(h, bodies, sources, v_trial_, rho) <= phi_k - 1e-4 * alpha * step_norm) break;
+    decreased = CalcMerit(h, bodies, sources, v_trial_, rho) <= phi_k - 1e-4 * alpha * step_norm;
+    if (decreased) break;
     certificate_step =
         halving == 0 && settings.certificate_steps &&
         AcceptFullStep(h, bodies, sources, settings, residual_k, kkt.max_primal(), stats);
     if (certificate_step) break;
-    alpha *= 0.5;
   }
+  if (!decreased && !certificate_step) return 0.0;  // no trial lowers the merit: v_k stays
   if (certificate_step) {
     // (v_QP, lambda_QP) exactly, so the next iteration takes the rows just collected there.
     v_k_ = v_qp_;

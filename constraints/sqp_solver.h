@@ -42,6 +42,9 @@ class SqpSolver {
   // CalcKktResidualsWithRefit; contact rows: impulses [N s]). Read-only: forces out.
   const IslandRows& rows() const { return rows_; }
   const VecX& multipliers() const { return reported_; }
+  // True when the last Solve stopped infeasible because neither the merit step nor a push-only
+  // restoration step lowered anything: the step is locally infeasible (docs/math.md §5.7).
+  bool stalled_infeasible() const { return stalled_infeasible_; }
 
  private:
   // Positions x_b of every body at velocities v (into x_).
@@ -65,11 +68,13 @@ class SqpSolver {
   bool AddRowsViolatedAtQpStep(double h, const std::vector<IslandBody*>& bodies,
                                const std::vector<ConstraintSource*>& sources, double distance_scale,
                                StepStats& stats);
-  // Restoration: v_k, lambda_k pushed towards v_QP as far as the violation drops.
-  void TakeRestorationStep(double h, const std::vector<IslandBody*>& bodies,
+  // Restoration: v_k, lambda_k pushed towards v_QP as far as the violation drops; false (and
+  // v_k kept) when no tried push lowers it.
+  bool TakeRestorationStep(double h, const std::vector<IslandBody*>& bodies,
                            const std::vector<ConstraintSource*>& sources,
                            const SqpSettings& settings, StepStats& stats);
-  // The merit line search (or certificate step) to the next iterate; returns the step length.
+  // The merit line search (or certificate step) to the next iterate; returns the step length, 0
+  // when no tried step lowers the merit (v_k, lambda_k kept).
   double TakeMeritStep(double h, const std::vector<IslandBody*>& bodies,
                        const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
                        const KktResiduals& kkt, double& rho, StepStats& stats);
@@ -113,9 +118,10 @@ class SqpSolver {
   KeyedMultipliers qp_keyed_;       // lambda_QP by key
   Eigen::RowVectorXd w_row_;        // one row of W being assembled
   std::vector<VecX> v_k_, v_qp_, v_trial_, dv_;
-  VecX scratch_, jt_;          // 3N work vectors (A dv, J^T lambda), reused across steps
-  KeyedMultipliers previous_;  // last step's multipliers by key
-  KeyedMultipliers iterate_;   // this step's lambda_k by key
+  VecX scratch_, jt_;                // 3N work vectors (A dv, J^T lambda), reused across steps
+  KeyedMultipliers previous_;        // last step's multipliers by key
+  bool stalled_infeasible_ = false;  // see stalled_infeasible()
+  KeyedMultipliers iterate_;         // this step's lambda_k by key
 };
 
 }  // namespace taut
