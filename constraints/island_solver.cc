@@ -17,9 +17,11 @@ const char* GetIslandSolverName(IslandSolverKind kind) {
   return "unknown";
 }
 
-IslandSolverKind IslandSolver::ChooseAuto(int rows, int free_dofs, int primal_steps_left) {
-  const bool many_rows = rows > kPrimalRowsPerDof * free_dofs;
-  return many_rows || primal_steps_left > 0 ? IslandSolverKind::kPrimal : IslandSolverKind::kDual;
+IslandSolverKind IslandSolver::ChooseAuto(int rows, int free_dofs, int primal_steps_left,
+                                          int dual_steps_left) {
+  if (primal_steps_left > 0) return IslandSolverKind::kPrimal;
+  if (dual_steps_left > 0) return IslandSolverKind::kDual;
+  return rows > kPrimalRowsPerDof * free_dofs ? IslandSolverKind::kPrimal : IslandSolverKind::kDual;
 }
 
 namespace {
@@ -38,7 +40,7 @@ IslandSolverKind IslandSolver::ChoosePath(const std::vector<IslandBody*>& bodies
   int free_dofs = 0;
   for (const IslandBody* body : bodies)
     for (int i = 0; i < body->num_blocks(); ++i) free_dofs += body->is_free_block(i) ? 3 : 0;
-  return ChooseAuto(last_rows_, free_dofs, primal_steps_left_);
+  return ChooseAuto(last_rows_, free_dofs, primal_steps_left_, dual_steps_left_);
 }
 
 void IslandSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
@@ -46,6 +48,7 @@ void IslandSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
                          StepStats& stats) {
   const IslandSolverKind kind = ChoosePath(bodies, settings);
   if (primal_steps_left_ > 0) --primal_steps_left_;
+  if (dual_steps_left_ > 0) --dual_steps_left_;
   const bool retry =
       settings.solver == IslandSolverKind::kAuto && settings.retry_failed_step_on_other_path;
   KeyedMultipliers warm_start;
@@ -59,9 +62,20 @@ void IslandSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
   // finger's locked advances): the primal retry failed there too, at three times the cost.
   const bool infeasible = kind == IslandSolverKind::kDual && dual_.stalled_infeasible();
   if (retry && !stats.converged && !infeasible) {
+    const bool primal_failed = kind == IslandSolverKind::kPrimal;
     const IslandSolverKind other =
-        kind == IslandSolverKind::kPrimal ? IslandSolverKind::kDual : IslandSolverKind::kPrimal;
-    RetryOn(other, h, bodies, sources, settings, std::move(warm_start), stats);
+        primal_failed ? IslandSolverKind::kDual : IslandSolverKind::kPrimal;
+    if (RetryOn(other, h, bodies, sources, settings, std::move(warm_start), stats)) {
+      // Measured: the path that certified what the other could not keeps the island (the
+      // primal for a limit-only island already does, SolveDual's rule).
+      if (primal_failed) {
+        primal_steps_left_ = 0;
+        dual_steps_left_ = dual_window_;
+        dual_window_ = std::min(2 * dual_window_, kMaxDualSteps);
+      } else {
+        dual_steps_left_ = 0;
+      }
+    }
   }
   last_rows_ = stats.rows_total();
 }
@@ -91,12 +105,13 @@ void IslandSolver::SolveDual(double h, const std::vector<IslandBody*>& bodies,
   for (const RowTypeInfo& info : kRowTypes)
     if (!info.is_limit && stats.rows_of(info.type) > 0) limit_rows_only = false;
   if (!stats.converged && limit_rows_only && settings.solver == IslandSolverKind::kAuto) {
+    dual_steps_left_ = 0;
     primal_steps_left_ = primal_window_;
     primal_window_ = std::min(2 * primal_window_, kMaxPrimalSteps);
   }
 }
 
-void IslandSolver::RetryOn(IslandSolverKind other, double h, const std::vector<IslandBody*>& bodies,
+bool IslandSolver::RetryOn(IslandSolverKind other, double h, const std::vector<IslandBody*>& bodies,
                            const std::vector<ConstraintSource*>& sources,
                            const SqpSettings& settings, KeyedMultipliers warm_start,
                            StepStats& stats) {
@@ -125,6 +140,7 @@ void IslandSolver::RetryOn(IslandSolverKind other, double h, const std::vector<I
     for (size_t b = 0; b < bodies.size(); ++b) bodies[b]->set_v(first_v_[b]);
   }
   stats.islands_retried++;
+  return retry.converged;
 }
 
 }  // namespace taut

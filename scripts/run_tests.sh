@@ -130,7 +130,7 @@ asan_long_tests+='|SnapshotOfAnotherWorldIsRefused|RestoredHexWorldContinuesBitI
 asan_long_tests+='|CertificateStepsCertifyTheHoldsBetweenPresses|AutoPathLeavesFewUncertifiedSteps'
 asan_long_tests+='|TetBodyRestsOnItsEmbeddedSurfaceInsteadOfItsBoundary|HangingCubeKeepsEveryElementBelowItsEnergyLimit'
 asan_long_tests+='|BoxOnASoftPadFeelsItsWeightAndThePadTheOpposite|SoftBlockRestingOnTheGroundReportsItsWeight'
-asan_long_tests+='|CrushedBlockKeepsEveryStretchAboveTheFloor|GripperSceneTest|CapsuleRolledOverASoftSlab'
+asan_long_tests+='|CrushedBlockKeepsEveryStretchAboveTheFloor|GripperScene|CapsuleRolledOverASoftSlab'
 
 # Stage 3: Debug build with AddressSanitizer + UBSan and its tests (without the long ones above).
 stage_asan() {

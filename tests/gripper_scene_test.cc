@@ -78,6 +78,29 @@ TEST_P(GripperSceneTest, SqueezesTheStrainLimitedCubeAndLiftsItOffTheGround) {
   EXPECT_NEAR(hold_force[0].z() + hold_force[1].z(), weight, 0.01 * weight);
 }
 
+// On the auto path the gripper's island takes the primal path by its rows per DOF; at first
+// contact that path fails and the dual retry certifies the step. The island then stays on the
+// dual path (IslandSolver::kDualStepsAfterPrimalFailure) instead of failing again at 50-110 ms a
+// step, as it did the next steps before.
+TEST(GripperSceneAutoTest, AfterAPrimalFailureTheDualRetryCertifiedTheIslandStaysDual) {
+  GripperScene scene;
+  scene.mutable_solver_settings().solver = IslandSolverKind::kAuto;
+  int step = 0;
+  for (; step < kSteps; ++step) {
+    scene.Step(kGripperStep);
+    const StepStats& stats = scene.last_step_stats();
+    if (stats.islands_retried > 0 && stats.islands_dual > 0 && stats.converged) break;
+  }
+  std::printf("first primal failure certified by the dual retry at step %d\n", step);
+  ASSERT_LT(step, kSteps) << "no step was retried onto the dual path";
+  for (int next = 0; next < 10; ++next) {
+    scene.Step(kGripperStep);
+    const StepStats& stats = scene.last_step_stats();
+    EXPECT_EQ(stats.islands_primal, 0) << "step " << step + 1 + next;
+    EXPECT_EQ(stats.islands_retried, 0) << "step " << step + 1 + next;
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(BothPaths, GripperSceneTest,
                          ::testing::Values(IslandSolverKind::kDual, IslandSolverKind::kPrimal),
                          [](const auto& info) {

@@ -336,13 +336,25 @@ TEST(HapticForceLoopTest, DynamicToolInTheIsland) {
   const HapticWrench w0 = loop.CalcToolWrench(ToolMotion());
   std::printf("dynamic box: report %.6f N, loop %.6f N (%d rows, %d tool rows, %d sweeps)\n",
               reported.force.z(), w0.force.z(), loop.lcp().size(), loop.num_tool_rows(), w0.sweeps);
-  // This island (102 rows on 225 free DOFs) takes the primal path, whose multipliers solve the
-  // frozen LCP to the certificate's tolerance (complementarity 1e-3 in C units), the loop's PGS
-  // to its own: measured 5e-5 of the force, and 2.5e-3 once failed steps of the rest were
-  // retried on the other path (a different trajectory to the same rest).
-  EXPECT_GT(holder.world.last_step_stats().islands_primal, 0);
-  EXPECT_LT((w0.force - reported.force).norm(), 5e-3 * reported.force.norm());
-  EXPECT_LT((w0.torque - reported.torque).norm(), 1e-3 * reported.force.norm() * 0.02);
+  // This island (102 rows on 225 free DOFs) takes the primal path by its rows per DOF, and the
+  // dual path for a while after a primal failure the dual retry certified. Either path's
+  // multipliers solve the frozen LCP to the certificate's tolerance, the loop's PGS to its own.
+  // The certificate lets a pushing contact row stand open by up to its complementarity (1e-3 in
+  // C units, 1e-5 m), which the frozen LCP closes: at the contact stiffness the loop measures
+  // (the 4 um press below, about 15 N/mm) that is up to 0.15 N. Measured: 3e-6 of the force
+  // after a dual step, 0.107 N after four primal steps certified at their warm start
+  // (complementarity 7.5e-4).
+  const SqpSettings& solver = holder.world.solver_settings();
+  const double open_gap = holder.world.last_step_stats().kkt_complementarity *
+                          solver.contact_tolerance / solver.violation_tolerance;
+  ToolMotion press;
+  press.displacement = Vec3(0.0, 0.0, -4e-6);
+  const double stiffness = (loop.CalcToolWrench(press).force.z() - w0.force.z()) / 4e-6;
+  const double force_bound = 5e-3 * reported.force.norm() + stiffness * open_gap;
+  std::printf("open gap %.2e m at %.0f N/m: force bound %.4f N\n", open_gap, stiffness,
+              force_bound);
+  EXPECT_LT((w0.force - reported.force).norm(), force_bound);
+  EXPECT_LT((w0.torque - reported.torque).norm(), 0.02 * force_bound);  // 0.02 m: the box's size
   double last = w0.force.z();
   for (double d : {0.5e-6, 1e-6, 2e-6, 4e-6}) {
     ToolMotion motion;

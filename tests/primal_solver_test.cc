@@ -364,6 +364,10 @@ TEST(PrimalSolverTest, AutoChoiceFollowsRowsPerDof) {
   EXPECT_EQ(IslandSolver::ChooseAuto(200, 300), IslandSolverKind::kPrimal);
   // A failed dual step sends the island to the primal path for a while.
   EXPECT_EQ(IslandSolver::ChooseAuto(50, 300, 3), IslandSolverKind::kPrimal);
+  // A failed primal step the dual retry certified sends it to the dual path for a while; a
+  // failed dual step of a limit-only island ends that (it clears dual_steps_left).
+  EXPECT_EQ(IslandSolver::ChooseAuto(200, 300, 0, 5), IslandSolverKind::kDual);
+  EXPECT_EQ(IslandSolver::ChooseAuto(200, 300, 3, 5), IslandSolverKind::kPrimal);
 }
 
 }  // namespace
