@@ -49,8 +49,10 @@ void IslandSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
   const IslandSolverKind kind = ChoosePath(bodies, settings);
   if (primal_steps_left_ > 0) --primal_steps_left_;
   if (dual_steps_left_ > 0) --dual_steps_left_;
-  const bool retry =
-      settings.solver == IslandSolverKind::kAuto && settings.retry_failed_step_on_other_path;
+  const bool retries_suspended = steps_without_retry_ > 0;
+  if (retries_suspended) --steps_without_retry_;
+  const bool retry = settings.solver == IslandSolverKind::kAuto &&
+                     settings.retry_failed_step_on_other_path && !retries_suspended;
   KeyedMultipliers warm_start;
   if (retry) {
     warm_start = warm_;
@@ -75,6 +77,10 @@ void IslandSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
       } else {
         dual_steps_left_ = 0;
       }
+    } else {
+      // Both paths failed: retries here are suspended for a while (measured cost, no gain).
+      steps_without_retry_ = no_retry_window_;
+      no_retry_window_ = std::min(2 * no_retry_window_, kMaxStepsWithoutRetry);
     }
   }
   last_rows_ = stats.rows_total();

@@ -33,6 +33,11 @@ class IslandSolver {
   // with a window of 20 and 11.1x with 80 (the dual path alone 10.8x, same run).
   static constexpr int kDualStepsAfterPrimalFailure = 80;
   static constexpr int kMaxDualSteps = 640;
+  // Steps without retries on an island after a retry there failed too (both paths failed the
+  // step); each further failed retry doubles it, up to kMaxStepsWithoutRetry. vertical_beam's
+  // collapsed columns: every dual retry of a failed primal step failed, at 340-1010 ms each.
+  static constexpr int kStepsWithoutRetryAfterFailedRetry = 20;
+  static constexpr int kMaxStepsWithoutRetry = 640;
 
   // The path kAuto takes for an island with `rows` rows (last step) on `free_dofs` free DOFs:
   // the primal path while `primal_steps_left` > 0 (after a failed dual step), else the dual path
@@ -50,9 +55,13 @@ class IslandSolver {
     int primal_window = kPrimalStepsAfterDualFailure;  // the next failure's primal_steps_left
     int dual_steps_left = 0;  // steps the dual path keeps after a primal failure it certified
     int dual_window = kDualStepsAfterPrimalFailure;  // the next such failure's dual_steps_left
+    int steps_without_retry = 0;  // steps left without retries after a failed retry
+    int no_retry_window = kStepsWithoutRetryAfterFailedRetry;  // the next one's
   };
   State SaveState() const {
-    return {warm_, last_rows_, primal_steps_left_, primal_window_, dual_steps_left_, dual_window_};
+    return {
+        warm_,        last_rows_,           primal_steps_left_, primal_window_, dual_steps_left_,
+        dual_window_, steps_without_retry_, no_retry_window_};
   }
   void RestoreState(const State& state) {
     warm_ = state.warm;
@@ -61,6 +70,8 @@ class IslandSolver {
     primal_window_ = state.primal_window;
     dual_steps_left_ = state.dual_steps_left;
     dual_window_ = state.dual_window;
+    steps_without_retry_ = state.steps_without_retry;
+    no_retry_window_ = state.no_retry_window;
   }
 
   // The rows of the last Solve at its final velocities and their multipliers, one per row
@@ -99,7 +110,9 @@ class IslandSolver {
   int primal_window_ = kPrimalStepsAfterDualFailure;  // primal steps after the next failure
   int dual_steps_left_ = 0;  // > 0: the primal path failed where the dual certified, stay dual
   int dual_window_ = kDualStepsAfterPrimalFailure;  // dual steps after the next such failure
-  bool solved_primal_ = false;                      // the last Solve took the primal path
+  int steps_without_retry_ = 0;  // > 0: a retry failed recently on this island, none now
+  int no_retry_window_ = kStepsWithoutRetryAfterFailedRetry;  // after the next failed retry
+  bool solved_primal_ = false;                                // the last Solve took the primal path
   std::vector<VecX> start_v_, first_v_;  // retry: velocities at the start and of the first path
 };
 
