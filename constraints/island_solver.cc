@@ -40,22 +40,21 @@ IslandSolverKind IslandSolver::ChoosePath(const std::vector<IslandBody*>& bodies
   int free_dofs = 0;
   for (const IslandBody* body : bodies)
     for (int i = 0; i < body->num_blocks(); ++i) free_dofs += body->is_free_block(i) ? 3 : 0;
-  return ChooseAuto(last_rows_, free_dofs, primal_steps_left_, dual_steps_left_);
+  return ChooseAuto(state_.last_rows, free_dofs, state_.primal.left, state_.dual.left);
 }
 
 void IslandSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
                          const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
                          StepStats& stats) {
   const IslandSolverKind kind = ChoosePath(bodies, settings);
-  if (primal_steps_left_ > 0) --primal_steps_left_;
-  if (dual_steps_left_ > 0) --dual_steps_left_;
-  const bool retries_suspended = steps_without_retry_ > 0;
-  if (retries_suspended) --steps_without_retry_;
+  state_.primal.Consume();
+  state_.dual.Consume();
+  const bool retries_suspended = state_.no_retry.Consume();
   const bool retry = settings.solver == IslandSolverKind::kAuto &&
                      settings.retry_failed_step_on_other_path && !retries_suspended;
   KeyedMultipliers warm_start;
   if (retry) {
-    warm_start = warm_;
+    warm_start = state_.warm;
     start_v_.resize(bodies.size());
     for (size_t b = 0; b < bodies.size(); ++b) start_v_[b] = bodies[b]->v();
   }
@@ -71,26 +70,24 @@ void IslandSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
       // Measured: the path that certified what the other could not keeps the island (the
       // primal for a limit-only island already does, SolveDual's rule).
       if (primal_failed) {
-        primal_steps_left_ = 0;
-        dual_steps_left_ = dual_window_;
-        dual_window_ = std::min(2 * dual_window_, kMaxDualSteps);
+        state_.primal.left = 0;
+        state_.dual.Open(kMaxDualSteps);
       } else {
-        dual_steps_left_ = 0;
+        state_.dual.left = 0;
       }
     } else {
       // Both paths failed: retries here are suspended for a while (measured cost, no gain).
-      steps_without_retry_ = no_retry_window_;
-      no_retry_window_ = std::min(2 * no_retry_window_, kMaxStepsWithoutRetry);
+      state_.no_retry.Open(kMaxStepsWithoutRetry);
     }
   }
-  last_rows_ = stats.rows_total();
+  state_.last_rows = stats.rows_total();
 }
 
 void IslandSolver::SolveOn(IslandSolverKind kind, double h, const std::vector<IslandBody*>& bodies,
                            const std::vector<ConstraintSource*>& sources,
                            const SqpSettings& settings, StepStats& stats) {
   if (kind == IslandSolverKind::kPrimal) {
-    primal_.Solve(h, bodies, sources, settings, warm_, stats);
+    primal_.Solve(h, bodies, sources, settings, state_.warm, stats);
     solved_primal_ = true;
   } else {
     SolveDual(h, bodies, sources, settings, stats);
@@ -100,9 +97,9 @@ void IslandSolver::SolveOn(IslandSolverKind kind, double h, const std::vector<Is
 void IslandSolver::SolveDual(double h, const std::vector<IslandBody*>& bodies,
                              const std::vector<ConstraintSource*>& sources,
                              const SqpSettings& settings, StepStats& stats) {
-  std::swap(dual_.mutable_warm_starts(), warm_);
+  std::swap(dual_.mutable_warm_starts(), state_.warm);
   dual_.Solve(h, bodies, sources, settings, stats);
-  std::swap(dual_.mutable_warm_starts(), warm_);
+  std::swap(dual_.mutable_warm_starts(), state_.warm);
   solved_primal_ = false;
   // Measured failure of a limit-only island: the next steps go to the primal path (kAuto
   // only). Islands with contact or joint rows stay dual: there the primal path failed more
@@ -111,9 +108,8 @@ void IslandSolver::SolveDual(double h, const std::vector<IslandBody*>& bodies,
   for (const RowTypeInfo& info : kRowTypes)
     if (!info.is_limit && stats.rows_of(info.type) > 0) limit_rows_only = false;
   if (!stats.converged && limit_rows_only && settings.solver == IslandSolverKind::kAuto) {
-    dual_steps_left_ = 0;
-    primal_steps_left_ = primal_window_;
-    primal_window_ = std::min(2 * primal_window_, kMaxPrimalSteps);
+    state_.dual.left = 0;
+    state_.primal.Open(kMaxPrimalSteps);
   }
 }
 
@@ -127,9 +123,9 @@ bool IslandSolver::RetryOn(IslandSolverKind other, double h, const std::vector<I
     first_v_[b] = bodies[b]->v();
     bodies[b]->set_v(start_v_[b]);
   }
-  KeyedMultipliers first_warm = std::move(warm_);
+  KeyedMultipliers first_warm = std::move(state_.warm);
   const bool first_primal = solved_primal_;
-  warm_ = std::move(warm_start);
+  state_.warm = std::move(warm_start);
   SqpSettings capped = settings;
   capped.max_iterations = std::min(settings.max_iterations, settings.retry_max_iterations);
   capped.primal.max_iterations =
@@ -141,7 +137,7 @@ bool IslandSolver::RetryOn(IslandSolverKind other, double h, const std::vector<I
     stats = retry;
   } else {
     AddDroppedSolveWork(retry, stats);
-    warm_ = std::move(first_warm);
+    state_.warm = std::move(first_warm);
     solved_primal_ = first_primal;
     for (size_t b = 0; b < bodies.size(); ++b) bodies[b]->set_v(first_v_[b]);
   }

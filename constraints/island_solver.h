@@ -3,12 +3,30 @@
 // constraints/primal_solver.h), chosen per island and step. Both share rows, keys and warm starts.
 #pragma once
 
+#include <algorithm>
 #include <vector>
 
 #include "constraints/primal_solver.h"
 #include "constraints/sqp_solver.h"
 
 namespace taut {
+
+// A run of steps that follows a measured event (a path failing, a retry failing): Open() starts
+// `next` steps and doubles `next` for the following event, up to a cap; Consume() tells whether a
+// step falls in the run and counts it.
+struct StepWindow {
+  int left = 0;  // steps of the current run still to come
+  int next;      // length of the next run
+  void Open(int max_steps) {
+    left = next;
+    next = std::min(2 * next, max_steps);
+  }
+  bool Consume() {
+    if (left == 0) return false;
+    --left;
+    return true;
+  }
+};
 
 class IslandSolver {
  public:
@@ -49,30 +67,14 @@ class IslandSolver {
   // What the next Solve depends on from earlier ones: the warm starts by row key and the path
   // rule's memory. Saved and restored by world snapshots (bullet_bridge/world_snapshot.h).
   struct State {
-    KeyedMultipliers warm;      // last step's multipliers by row key
-    int last_rows = 0;          // rows at the end of the last step
-    int primal_steps_left = 0;  // steps the primal path keeps after a dual failure
-    int primal_window = kPrimalStepsAfterDualFailure;  // the next failure's primal_steps_left
-    int dual_steps_left = 0;  // steps the dual path keeps after a primal failure it certified
-    int dual_window = kDualStepsAfterPrimalFailure;  // the next such failure's dual_steps_left
-    int steps_without_retry = 0;  // steps left without retries after a failed retry
-    int no_retry_window = kStepsWithoutRetryAfterFailedRetry;  // the next one's
+    KeyedMultipliers warm;                               // last step's multipliers by row key
+    int last_rows = 0;                                   // rows at the end of the last step
+    StepWindow primal{0, kPrimalStepsAfterDualFailure};  // primal path after a dual failure
+    StepWindow dual{0, kDualStepsAfterPrimalFailure};    // dual path after a primal failure
+    StepWindow no_retry{0, kStepsWithoutRetryAfterFailedRetry};  // no retries after a failed one
   };
-  State SaveState() const {
-    return {
-        warm_,        last_rows_,           primal_steps_left_, primal_window_, dual_steps_left_,
-        dual_window_, steps_without_retry_, no_retry_window_};
-  }
-  void RestoreState(const State& state) {
-    warm_ = state.warm;
-    last_rows_ = state.last_rows;
-    primal_steps_left_ = state.primal_steps_left;
-    primal_window_ = state.primal_window;
-    dual_steps_left_ = state.dual_steps_left;
-    dual_window_ = state.dual_window;
-    steps_without_retry_ = state.steps_without_retry;
-    no_retry_window_ = state.no_retry_window;
-  }
+  State SaveState() const { return state_; }
+  void RestoreState(const State& state) { state_ = state; }
 
   // The rows of the last Solve at its final velocities and their multipliers, one per row
   // (contact rows: impulses [N s]; limit rows [N m s]), from the path that ran. Reading them
@@ -90,7 +92,7 @@ class IslandSolver {
   void SolveOn(IslandSolverKind kind, double h, const std::vector<IslandBody*>& bodies,
                const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
                StepStats& stats);
-  // The dual path, with the failure rule of kAuto (primal_steps_left_).
+  // The dual path, with the failure rule of kAuto (the primal window).
   void SolveDual(double h, const std::vector<IslandBody*>& bodies,
                  const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
                  StepStats& stats);
@@ -104,15 +106,8 @@ class IslandSolver {
 
   SqpSolver dual_;
   PrimalSolver primal_;
-  KeyedMultipliers warm_;      // last step's multipliers by key, whichever path ran
-  int last_rows_ = 0;          // rows at the end of the last step
-  int primal_steps_left_ = 0;  // > 0: the dual path failed recently, stay primal
-  int primal_window_ = kPrimalStepsAfterDualFailure;  // primal steps after the next failure
-  int dual_steps_left_ = 0;  // > 0: the primal path failed where the dual certified, stay dual
-  int dual_window_ = kDualStepsAfterPrimalFailure;  // dual steps after the next such failure
-  int steps_without_retry_ = 0;  // > 0: a retry failed recently on this island, none now
-  int no_retry_window_ = kStepsWithoutRetryAfterFailedRetry;  // after the next failed retry
-  bool solved_primal_ = false;                                // the last Solve took the primal path
+  State state_;                          // warm starts, last row count, the path rule's windows
+  bool solved_primal_ = false;           // the last Solve took the primal path
   std::vector<VecX> start_v_, first_v_;  // retry: velocities at the start and of the first path
 };
 
