@@ -107,7 +107,9 @@ void IslandSolver::SolveDual(double h, const std::vector<IslandBody*>& bodies,
   bool limit_rows_only = true;
   for (const RowTypeInfo& info : kRowTypes)
     if (!info.is_limit && stats.rows_of(info.type) > 0) limit_rows_only = false;
-  if (!stats.converged && limit_rows_only && settings.solver == IslandSolverKind::kAuto) {
+  const bool costly = stats.sqp_iterations > kCostlyDualSqpIterations;
+  if ((!stats.converged || costly) && limit_rows_only &&
+      settings.solver == IslandSolverKind::kAuto) {
     state_.dual.left = 0;
     state_.primal.Open(kMaxPrimalSteps);
   }

@@ -13,6 +13,13 @@ double KktResiduals::max_complementarity() const {
   return *std::max_element(complementarity.begin(), complementarity.end());
 }
 
+double KktResiduals::max_distance_residual() const {
+  double residual = 0.0;
+  for (int i = 0; i < kNumRowTypes; ++i)
+    if (!kRowTypes[i].is_limit) residual = std::max({residual, primal[i], complementarity[i]});
+  return residual;
+}
+
 bool KktResiduals::IsFeasible(double violation_tolerance) const {
   return max_primal() <= violation_tolerance && max_complementarity() <= violation_tolerance;
 }

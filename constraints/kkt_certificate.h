@@ -28,6 +28,9 @@ struct KktResiduals {
 
   double max_primal() const;
   double max_complementarity() const;
+  // The largest primal or complementarity residual of the distance rows (contacts, joints; in
+  // limit-row units), 0 without such rows.
+  double max_distance_residual() const;
 };
 
 // Residuals of `rows` (collected at v) with multipliers lambda. `scratch` is a work vector.

@@ -580,11 +580,7 @@ bool PrimalSolver::IsNewtonIterateCertified(const std::vector<IslandBody*>& bodi
     return false;
   const double distance_tolerance =
       settings.primal.newton_stop_distance_factor * settings.violation_tolerance;
-  for (int i = 0; i < kNumRowTypes; ++i)
-    if (!kRowTypes[i].is_limit &&
-        std::max(kkt.primal[i], kkt.complementarity[i]) > distance_tolerance)
-      return false;
-  return true;
+  return kkt.max_distance_residual() <= distance_tolerance;
 }
 
 bool PrimalSolver::WarmStartVelocities(const std::vector<IslandBody*>& bodies) {

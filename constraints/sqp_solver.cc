@@ -115,8 +115,28 @@ void SqpSolver::Solve(double h, const std::vector<DeformableBody*>& bodies,
 void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
                       const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
                       StepStats& stats) {
-  const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
   BeginSolve(bodies, settings);
+  warm_started_ = settings.warm_start && settings.warm_start_velocity &&
+                  StartFromWarmMultipliers(h, bodies, sources, settings, stats);
+  Iterate(h, bodies, sources, settings, stats);
+  if (warm_started_ && !stats.converged) {
+    // Not certified from the warm-start velocity: the papers' start v* (docs/math.md §5.7).
+    const int iterations = stats.sqp_iterations;
+    BeginSolve(bodies, settings);
+    warm_started_ = false;
+    Iterate(h, bodies, sources, settings, stats);
+    stats.sqp_iterations += iterations;
+  }
+  for (size_t b = 0; b < bodies.size(); ++b) bodies[b]->set_v(v_k_[b]);
+  rows_.Store(lambda_, previous_);
+  stats.islands_dual++;
+}
+
+void SqpSolver::Iterate(double h, const std::vector<IslandBody*>& bodies,
+                        const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
+                        StepStats& stats) {
+  const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
+  stats.sqp_iterations = 0;
   double rho = 0.0, last_alpha = 1.0;
   bool restoring = false;
   for (int k = 0;; ++k) {
@@ -128,6 +148,8 @@ void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     if (rows_.empty()) {
       lambda_.resize(0);
       reported_.resize(0);
+      // Without rows the minimizer is v*: a warm start inside every margin starts over there.
+      if (k == 0 && warm_started_) stats.converged = false;
       break;  // nothing active: no LCP at all
     }
     // Certificate of the iterate (constraints/kkt_certificate.h).
@@ -143,9 +165,18 @@ void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     const bool feasible = violation <= settings.violation_tolerance;
     stats.converged =
         IsCertified(kkt, settings.violation_tolerance, settings.stationarity_tolerance);
-    const bool done = settings.certificate_steps ? stats.converged
-                                                 : stationarity <= settings.stationarity_tolerance;
-    if (feasible && (restoring || done || force_free || last_alpha < settings.stalled_step)) break;
+    // At the warm-start velocity (no QP yet) distance rows must hold to warm_stop_distance_factor
+    // of their tolerance: certified at the tolerance's edge step after step, a pressed contact
+    // sinks to the full tolerance (docs/math.md §5.7, warm-start velocity).
+    const bool tight = !warm_started_ ||
+                       (k > 0 && kkt.max_distance_residual() <= settings.warm_stop_distance_factor *
+                                                                    settings.violation_tolerance);
+    const bool done =
+        tight && (settings.certificate_steps ? stats.converged
+                                             : stationarity <= settings.stationarity_tolerance);
+    if (feasible &&
+        (restoring || done || (tight && force_free) || last_alpha < settings.stalled_step))
+      break;
     if (k >= settings.max_iterations) {
       // SQP cap reached while infeasible: push-only restoration steps (docs/math.md §5.7,
       // "incremental dlambda >= 0": feasible in a few iterations, at the price of stationarity).
@@ -183,9 +214,6 @@ void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
       break;
     }
   }
-  for (size_t b = 0; b < bodies.size(); ++b) bodies[b]->set_v(v_k_[b]);
-  rows_.Store(lambda_, previous_);
-  stats.islands_dual++;
 }
 
 void SqpSolver::BeginSolve(const std::vector<IslandBody*>& bodies, const SqpSettings& settings) {
@@ -204,6 +232,31 @@ void SqpSolver::BeginSolve(const std::vector<IslandBody*>& bodies, const SqpSett
     iterate_.clear();
   }
   full_rows_at_v_k_ = full_rows_at_v_qp_ = false;
+}
+
+bool SqpSolver::StartFromWarmMultipliers(double h, const std::vector<IslandBody*>& bodies,
+                                         const std::vector<ConstraintSource*>& sources,
+                                         const SqpSettings& settings, StepStats& stats) {
+  if (previous_.empty()) return false;
+  const size_t nb = bodies.size();
+  for (size_t b = 0; b < nb; ++b) v_trial_[b].setZero(v_k_[b].size());
+  const auto t_rows = std::chrono::steady_clock::now();
+  const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
+  full_rows_.Collect(h, bodies, sources, v_trial_, distance_scale);  // at x0 (v = 0)
+  stats.ms_rows += MsSince(t_rows);
+  full_rows_.WarmStart(previous_, full_lambda_);
+  if (full_rows_.empty() || full_lambda_.cwiseAbs().maxCoeff() == 0.0) return false;
+  // v = v* + A^-1 J_0^T lambda_0 (docs/math.md §5.7, warm-start velocity).
+  for (size_t b = 0; b < nb; ++b) dv_[b].setZero(v_k_[b].size());
+  for (int c = 0; c < full_rows_.size(); ++c)
+    full_rows_[c].ForEachEntry([&](int body, int block, const Vec3& J) {
+      dv_[body].segment<3>(3 * block) += full_lambda_[c] * J;
+    });
+  for (size_t b = 0; b < nb; ++b) {
+    bodies[b]->SolveSystemApproximately(dv_[b]);  // a start only: a kept factor serves
+    v_k_[b] += dv_[b];
+  }
+  return true;
 }
 
 double SqpSolver::CollectRowsAtIterate(double h, const std::vector<IslandBody*>& bodies,

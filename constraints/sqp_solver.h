@@ -24,7 +24,9 @@ namespace taut {
 //   v_k||_A^2, phi(v) = 1/2 ||v - v*||_A^2 + rho sum max(0, -C)/h, rho >= 2 max lambda
 //   (non-decreasing); v, lambda <- v_k + alpha (QP - k).
 // Bilateral rows (joints, attachments) enter with a free multiplier and violation |C|.
-// Bodies enter with v = v* (after BeginStep) and leave with the constrained v.
+// Bodies enter with v = v* (after BeginStep) and leave with the constrained v. v_0 = v*, or with
+// SqpSettings::warm_start_velocity v* + A^-1 J_0^T lambda_0 (the last step's multipliers on the
+// rows at x0), falling back to v* when the solve from there fails (docs/math.md §5.7).
 class SqpSolver {
  public:
   // Solves one step of length h for the island `bodies`; fills the constraint part of `stats`.
@@ -51,6 +53,16 @@ class SqpSolver {
   void CalcPositions(double h, const std::vector<IslandBody*>& bodies, const std::vector<VecX>& v);
   // The stages of Solve, in order. Per-step set-up: sizes, v_k = v*, warm starts, no kept columns.
   void BeginSolve(const std::vector<IslandBody*>& bodies, const SqpSettings& settings);
+  // Stage: v_k = v* + A^-1 J_0^T lambda_0, the last step's multipliers (by key) on the rows at the
+  // step's start positions x0 (where the last step collected its final rows), when it has any
+  // (returns whether v_k moved).
+  bool StartFromWarmMultipliers(double h, const std::vector<IslandBody*>& bodies,
+                                const std::vector<ConstraintSource*>& sources,
+                                const SqpSettings& settings, StepStats& stats);
+  // Stage: the SQP iterations from v_k until certified, capped or stalled.
+  void Iterate(double h, const std::vector<IslandBody*>& bodies,
+               const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
+               StepStats& stats);
   // Rows at x_k = x0 + h v_k (or those a certificate step collected there); returns their
   // largest violation.
   double CollectRowsAtIterate(double h, const std::vector<IslandBody*>& bodies,
@@ -122,6 +134,7 @@ class SqpSolver {
   KeyedMultipliers previous_;        // last step's multipliers by key
   bool stalled_infeasible_ = false;  // see stalled_infeasible()
   KeyedMultipliers iterate_;         // this step's lambda_k by key
+  bool warm_started_ = false;        // this Iterate starts from the warm-start velocity
 };
 
 }  // namespace taut

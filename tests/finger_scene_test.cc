@@ -116,6 +116,9 @@ TEST(FingerSceneTest, RowsFoundAtTheQpStepCutTheFlatPressSqpIterations) {
   for (int passes : {0, 3}) {
     FingerScene scene({FingerScene::DefaultPresses()[0]}, FingerSceneSettings());
     scene.world().mutable_solver_settings().max_row_discovery_passes = passes;
+    // From the papers' start v*, where the QP's push crosses the margins (the warm-start
+    // velocity starts near the answer and needs few rows found).
+    scene.world().mutable_solver_settings().warm_start_velocity = false;
     RunPresses(scene, 1e-3);
     result[passes > 0] = scene.result(0);
   }
@@ -144,6 +147,8 @@ TEST(FingerSceneTest, CertificateStepsCertifyTheHoldsBetweenPresses) {
     settings.take_back_locked_advances = false;
     FingerScene scene(FingerScene::DefaultPresses(), settings);
     scene.world().mutable_solver_settings().certificate_steps = on != 0;
+    // From the papers' start v* (the warm-start velocity starts the holds at their answer).
+    scene.world().mutable_solver_settings().warm_start_velocity = false;
     // The dual path's own figures: no second solve on the primal path for its failed steps.
     scene.world().mutable_solver_settings().retry_failed_step_on_other_path = false;
     for (int step = 0; step < 5000 && scene.current_press() < scene.num_presses(); ++step) {
@@ -161,6 +166,40 @@ TEST(FingerSceneTest, CertificateStepsCertifyTheHoldsBetweenPresses) {
   EXPECT_LE(unconverged[1], 5);
   EXPECT_GE(unconverged[0], 15);
   EXPECT_LE(max_violation[1], max_violation[0] * 1.01);
+}
+
+// The dual path's warm-start velocity (SqpSettings::warm_start_velocity, docs/math.md §5.7): the
+// SQP starts from v* + A^-1 J_0^T lambda_0, the last step's impulses on the rows at the step's
+// start, instead of v*. Over the demo's six presses: the same presses (stop reasons, reactions
+// and indentations within 1 %), every step certified, and fewer SQP iterations and PGS sweeps.
+TEST(FingerSceneTest, WarmStartVelocityKeepsThePressesWithFewerIterations) {
+  FingerPressResult result[2][6];
+  long sqp[2] = {0, 0}, sweeps[2] = {0, 0}, unconverged[2] = {0, 0};
+  for (int on = 0; on < 2; ++on) {
+    FingerScene scene(FingerScene::DefaultPresses(), FingerSceneSettings());
+    scene.world().mutable_solver_settings().warm_start_velocity = on != 0;
+    for (int step = 0; step < 5000 && scene.current_press() < scene.num_presses(); ++step) {
+      scene.Step(1e-3);
+      const StepStats& stats = scene.world().last_step_stats();
+      sqp[on] += stats.sqp_iterations;
+      sweeps[on] += stats.pgs_sweeps;
+      unconverged[on] += stats.converged ? 0 : 1;
+    }
+    ASSERT_EQ(scene.current_press(), scene.num_presses());
+    for (int p = 0; p < scene.num_presses(); ++p) result[on][p] = scene.result(p);
+  }
+  std::printf("SQP iterations %ld -> %ld, PGS sweeps %ld -> %ld, unconverged %ld -> %ld\n", sqp[0],
+              sqp[1], sweeps[0], sweeps[1], unconverged[0], unconverged[1]);
+  for (int p = 0; p < 6; ++p) {
+    const FingerPressResult& off = result[0][p];
+    const FingerPressResult& on = result[1][p];
+    EXPECT_EQ(on.stop_reason, off.stop_reason) << off.name;
+    EXPECT_NEAR(on.reaction, off.reaction, 0.01 * off.reaction) << off.name;
+    EXPECT_NEAR(on.indentation, off.indentation, 0.01 * off.indentation) << off.name;
+  }
+  EXPECT_EQ(unconverged[1], 0);
+  EXPECT_LT(sqp[1], 0.85 * sqp[0]);
+  EXPECT_LT(sweeps[1], 0.5 * sweeps[0]);
 }
 
 }  // namespace

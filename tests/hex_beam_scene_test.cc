@@ -4,6 +4,8 @@
 
 #include <cstdio>
 
+#include "constraints/island_solver.h"
+
 namespace taut {
 namespace {
 
@@ -57,6 +59,34 @@ TEST(HexBeamSceneTest, AutoPathLeavesFewUncertifiedSteps) {
   std::printf("hex_beam, auto: %d of 480 steps uncertified, %d primal island solves\n", unconverged,
               primal);
   EXPECT_LE(unconverged, 6);
+}
+
+// The auto path's cost rule (IslandSolver::kCostlyDualSqpIterations): a certified dual step of a
+// limit-only island that needed more than 4 SQP iterations sends the island to the primal path
+// for the next steps. On the 0.1 J beam alone every such step is followed by a primal step, and
+// the run stays within the hex beam's target of 4 SQP iterations per step on average.
+TEST(HexBeamSceneTest, CostlyDualStepsSendTheLimitOnlyIslandToThePrimalPath) {
+  HexBeamScene scene({HexBeamScene::DefaultBeams()[3]});
+  int costly = 0, followed = 0, sqp = 0, unconverged = 0;
+  bool last_costly = false;
+  for (int step = 0; step < 240; ++step) {
+    scene.Step(1.0 / 240.0);
+    const StepStats& stats = scene.world().last_step_stats();
+    if (last_costly) followed += stats.islands_primal > 0 ? 1 : 0;
+    last_costly = stats.islands_dual > 0 && stats.converged &&
+                  stats.sqp_iterations > IslandSolver::kCostlyDualSqpIterations;
+    costly += last_costly ? 1 : 0;
+    sqp += stats.sqp_iterations;
+    unconverged += stats.converged ? 0 : 1;
+  }
+  std::printf(
+      "0.1 J beam, auto: %d costly dual steps, %d followed by a primal step, %.2f SQP "
+      "iterations per step, %d uncertified\n",
+      costly, followed, sqp / 240.0, unconverged);
+  EXPECT_GT(costly, 0);  // the rule is exercised
+  EXPECT_EQ(followed, costly - (last_costly ? 1 : 0));
+  EXPECT_LE(sqp, 4 * 240);
+  EXPECT_LE(unconverged, 2);
 }
 
 }  // namespace
