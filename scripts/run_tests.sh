@@ -131,7 +131,7 @@ asan_long_tests+='|CertificateStepsCertifyTheHoldsBetweenPresses|AutoPathLeavesF
 asan_long_tests+='|TetBodyRestsOnItsEmbeddedSurfaceInsteadOfItsBoundary|HangingCubeKeepsEveryElementBelowItsEnergyLimit'
 asan_long_tests+='|BoxOnASoftPadFeelsItsWeightAndThePadTheOpposite|SoftBlockRestingOnTheGroundReportsItsWeight'
 asan_long_tests+='|CrushedBlockKeepsEveryStretchAboveTheFloor|GripperScene|CapsuleRolledOverASoftSlab'
-asan_long_tests+='|AfterAFailedRetryTheIslandIsNotRetriedForAWhile'
+asan_long_tests+='|AfterAFailedRetryTheIslandIsNotRetriedForAWhile|WarmStartVelocityKeepsThePresses'
 
 # Stage 3: Debug build with AddressSanitizer + UBSan and its tests (without the long ones above).
 stage_asan() {
