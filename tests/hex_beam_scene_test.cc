@@ -63,10 +63,12 @@ TEST(HexBeamSceneTest, AutoPathLeavesFewUncertifiedSteps) {
 
 // The auto path's cost rule (IslandSolver::kCostlyDualSqpIterations): a certified dual step of a
 // limit-only island that needed more than 4 SQP iterations sends the island to the primal path
-// for the next steps. On the 0.1 J beam alone every such step is followed by a primal step, and
-// the run stays within the hex beam's target of 4 SQP iterations per step on average.
+// for the next steps. On the 0.1 J beam alone, from the papers' start v* (9.5 SQP iterations per
+// dual step there; the warm-start velocity rarely needs more than 4), every such step is followed
+// by a primal step, and the run stays within the hex beam's target of 4 SQP iterations per step.
 TEST(HexBeamSceneTest, CostlyDualStepsSendTheLimitOnlyIslandToThePrimalPath) {
   HexBeamScene scene({HexBeamScene::DefaultBeams()[3]});
+  scene.world().mutable_solver_settings().warm_start_velocity = false;
   int costly = 0, followed = 0, sqp = 0, unconverged = 0;
   bool last_costly = false;
   for (int step = 0; step < 240; ++step) {
