@@ -154,4 +154,18 @@ double IslandRows::CalcRowVelocity(int c, const std::vector<VecX>& v) const {
   return jv;
 }
 
+void IslandRows::AddImpulseVelocities(const std::vector<IslandBody*>& bodies, const VecX& lambda,
+                                      std::vector<VecX>& work, std::vector<VecX>& v) const {
+  work.resize(bodies.size());
+  for (size_t b = 0; b < bodies.size(); ++b) work[b].setZero(v[b].size());
+  for (int c = 0; c < size(); ++c)
+    rows_[c].ForEachEntry([&](int body, int block, const Vec3& J) {
+      work[body].segment<3>(3 * block) += lambda[c] * J;
+    });
+  for (size_t b = 0; b < bodies.size(); ++b) {
+    bodies[b]->SolveSystemApproximately(work[b]);
+    v[b] += work[b];
+  }
+}
+
 }  // namespace taut

@@ -51,6 +51,11 @@ class IslandRows {
   void CountTypes(StepStats& stats) const;
   // J v of a row for per-body velocities v.
   double CalcRowVelocity(int c, const std::vector<VecX>& v) const;
+  // v_b += P_b^-1 (J^T lambda)_b for every body, P_b the factor body b holds
+  // (IslandBody::SolveSystemApproximately): the velocity change the impulses lambda (one per row)
+  // give, for start candidates. `work` is per-body scratch.
+  void AddImpulseVelocities(const std::vector<IslandBody*>& bodies, const VecX& lambda,
+                            std::vector<VecX>& work, std::vector<VecX>& v) const;
 
   int size() const { return static_cast<int>(rows_.size()); }
   bool empty() const { return rows_.empty(); }

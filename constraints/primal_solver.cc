@@ -587,15 +587,8 @@ bool PrimalSolver::WarmStartVelocities(const std::vector<IslandBody*>& bodies) {
   // v = v* + A^-1 J^T lambda_bar (the previous step's impulses on this step's rows), with the
   // factor the unconstrained solve held: only a candidate start, so a kept factor does.
   if (rows_.empty() || lambda_bar_.cwiseAbs().maxCoeff() == 0.0) return false;
-  for (size_t b = 0; b < bodies.size(); ++b) work_[b].setZero();
-  for (int c = 0; c < rows_.size(); ++c)
-    rows_[c].ForEachEntry([&](int body, int block, const Vec3& J) {
-      work_[body].segment<3>(3 * block) += lambda_bar_[c] * J;
-    });
-  for (size_t b = 0; b < bodies.size(); ++b) {
-    bodies[b]->SolveSystemApproximately(work_[b]);
-    v_trial_[b] = v_[b] + work_[b];
-  }
+  v_trial_ = v_;
+  rows_.AddImpulseVelocities(bodies, lambda_bar_, work_, v_trial_);
   return true;
 }
 

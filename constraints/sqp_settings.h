@@ -78,9 +78,9 @@ struct SqpSettings {
   bool warm_start = true;  // warm-start lambda from the previous step by row key
   // Dual path: the SQP starts from v* + A^-1 J_0^T lambda_0, the warm multipliers on the rows at
   // the step's start positions, instead of v* (docs/math.md §5.7, warm-start velocity).
-  // Not certified there (or without rows there), the SQP starts over from v*. Certified there
-  // before any QP only with distance rows (contacts, joints) within warm_stop_distance_factor
-  // of their tolerance.
+  // From there the SQP runs at least one QP and is certified only with distance rows (contacts,
+  // joints) within warm_stop_distance_factor of their tolerance; not certified (or without rows
+  // there), it starts over from v*.
   bool warm_start_velocity = true;
   double warm_stop_distance_factor = 0.1;
   // Which island solver runs (constraints/island_solver.h) and the primal path's settings.

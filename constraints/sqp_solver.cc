@@ -115,6 +115,7 @@ void SqpSolver::Solve(double h, const std::vector<DeformableBody*>& bodies,
 void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
                       const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
                       StepStats& stats) {
+  columns_.Clear();  // this step's A (kept through a restart from v*: A is the same)
   BeginSolve(bodies, settings);
   warm_started_ = settings.warm_start && settings.warm_start_velocity &&
                   StartFromWarmMultipliers(h, bodies, sources, settings, stats);
@@ -165,9 +166,10 @@ void SqpSolver::Iterate(double h, const std::vector<IslandBody*>& bodies,
     const bool feasible = violation <= settings.violation_tolerance;
     stats.converged =
         IsCertified(kkt, settings.violation_tolerance, settings.stationarity_tolerance);
-    // At the warm-start velocity (no QP yet) distance rows must hold to warm_stop_distance_factor
-    // of their tolerance: certified at the tolerance's edge step after step, a pressed contact
-    // sinks to the full tolerance (docs/math.md §5.7, warm-start velocity).
+    // From the warm-start velocity: at least one QP (certified at the start itself, a contact
+    // pushed in by less than its tolerance kept its old impulse), and distance rows within
+    // warm_stop_distance_factor of their tolerance (certified at the tolerance's edge step after
+    // step, a pressed contact sinks to the full tolerance; docs/math.md §5.7).
     const bool tight = !warm_started_ ||
                        (k > 0 && kkt.max_distance_residual() <= settings.warm_stop_distance_factor *
                                                                     settings.violation_tolerance);
@@ -224,7 +226,6 @@ void SqpSolver::BeginSolve(const std::vector<IslandBody*>& bodies, const SqpSett
   v_trial_.resize(nb);
   dv_.resize(nb);
   for (size_t b = 0; b < nb; ++b) v_k_[b] = bodies[b]->v();
-  columns_.Clear();  // this step's A
   stalled_infeasible_ = false;
   if (settings.warm_start) {
     iterate_ = previous_;
@@ -246,16 +247,9 @@ bool SqpSolver::StartFromWarmMultipliers(double h, const std::vector<IslandBody*
   stats.ms_rows += MsSince(t_rows);
   full_rows_.WarmStart(previous_, full_lambda_);
   if (full_rows_.empty() || full_lambda_.cwiseAbs().maxCoeff() == 0.0) return false;
-  // v = v* + A^-1 J_0^T lambda_0 (docs/math.md §5.7, warm-start velocity).
-  for (size_t b = 0; b < nb; ++b) dv_[b].setZero(v_k_[b].size());
-  for (int c = 0; c < full_rows_.size(); ++c)
-    full_rows_[c].ForEachEntry([&](int body, int block, const Vec3& J) {
-      dv_[body].segment<3>(3 * block) += full_lambda_[c] * J;
-    });
-  for (size_t b = 0; b < nb; ++b) {
-    bodies[b]->SolveSystemApproximately(dv_[b]);  // a start only: a kept factor serves
-    v_k_[b] += dv_[b];
-  }
+  // v = v* + A^-1 J_0^T lambda_0 (docs/math.md §5.7, warm-start velocity); a start only, so the
+  // factor each body holds serves.
+  full_rows_.AddImpulseVelocities(bodies, full_lambda_, dv_, v_k_);
   return true;
 }
 

@@ -51,7 +51,7 @@ class SqpSolver {
  private:
   // Positions x_b of every body at velocities v (into x_).
   void CalcPositions(double h, const std::vector<IslandBody*>& bodies, const std::vector<VecX>& v);
-  // The stages of Solve, in order. Per-step set-up: sizes, v_k = v*, warm starts, no kept columns.
+  // The stages of Solve, in order. Set-up of a solve from v*: sizes, v_k = v*, warm starts.
   void BeginSolve(const std::vector<IslandBody*>& bodies, const SqpSettings& settings);
   // Stage: v_k = v* + A^-1 J_0^T lambda_0, the last step's multipliers (by key) on the rows at the
   // step's start positions x0 (where the last step collected its final rows), when it has any
