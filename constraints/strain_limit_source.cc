@@ -29,32 +29,52 @@ StrainLimitSource::StrainLimitSource(const DeformableBody& body,
   // 1 + (1-tau)/max kappa_max], and above the floor's activation (below).
   screen_ = params_.projection == StrainProjection::kHyperbolic ||
             params_.projection == StrainProjection::kEllipsoid;
-  const double slack = 1.0 - params_.activation_margin;
-  stretch_hi_ = params_.has_max ? 1.0 + slack / params_.kappa_max.maxCoeff() : HUGE_VAL;
-  stretch_lo_ = params_.has_min ? 1.0 - slack / params_.kappa_min.maxCoeff() : 0.0;
-  // Floor rows C = (s_i - f) / (1 - f) are active below s_i = f + tau (1 - f) (docs/math.md §3.8).
-  if (params_.inversion_floor > 0.0) {
-    const double f = params_.inversion_floor;
-    stretch_lo_ = std::max(stretch_lo_, f + params_.activation_margin * (1.0 - f));
+  // Rows are emitted below C = tau (the activation band); a violation needs C < 0 (the wider
+  // band of tau = 0).
+  const double tau = params_.activation_margin;
+  screen_ = screen_ && std::isfinite(tau) && tau < 1.0;
+  if (screen_) {
+    active_band_ = CalcStretchBand(tau);
+    violation_band_ = CalcStretchBand(0.0);
   }
-  screen_ = screen_ && std::isfinite(slack) && slack > 0.0;
 }
 
-bool StrainLimitSource::IsSurelyInactive(const std::array<Vec3, 4>& xe, int e) const {
+StrainLimitSource::StretchBand StrainLimitSource::CalcStretchBand(double tau) const {
+  // Every row of principal axis i has C >= 1 - max_j kappa^j |s_i - 1| (> tau inside the band);
+  // floor rows C = (s_i - f) / (1 - f) exceed tau above s_i = f + tau (1 - f) (docs/math.md §3.8).
+  const double slack = 1.0 - tau;
+  StretchBand band;
+  band.hi = params_.has_max ? 1.0 + slack / params_.kappa_max.maxCoeff() : HUGE_VAL;
+  band.lo = params_.has_min ? 1.0 - slack / params_.kappa_min.maxCoeff() : 0.0;
+  if (params_.inversion_floor > 0.0) {
+    const double f = params_.inversion_floor;
+    band.lo = std::max(band.lo, f + tau * (1.0 - f));
+  }
+  band.lo = std::max(band.lo, 0.0);
+  return band;
+}
+
+namespace {
+// True when the symmetric 3x3 M is positive definite: its leading principal minors are positive
+// (Sylvester's criterion).
+bool IsPositiveDefinite(const Mat3& M) {
+  const double minor2 = M(0, 0) * M(1, 1) - M(0, 1) * M(0, 1);
+  return M(0, 0) > 0.0 && minor2 > 0.0 && M.determinant() > 0.0;
+}
+}  // namespace
+
+bool StrainLimitSource::IsSurelyInside(const std::array<Vec3, 4>& xe, int e,
+                                       const StretchBand& band) const {
   if (!screen_) return false;
-  // Principal stretches are the square roots of the eigenvalues of F^T F, which lie in the
-  // union of its Gershgorin discs; a non-positive det F (inverted) is never screened out.
+  // The principal stretches are the square roots of the eigenvalues of F^T F, so all of them lie
+  // in (lo, hi) exactly when F^T F - lo^2 I and hi^2 I - F^T F are positive definite; a
+  // non-positive det F (inverted: s_3 <= 0) is never inside.
   const Mat3 F = CalcTetDeformationGradient(tets_.rest().elements[e], xe);
   if (!(F.determinant() > 0.0)) return false;
   const Mat3 c = F.transpose() * F;
-  double lo = HUGE_VAL, hi = -HUGE_VAL;
-  for (int k = 0; k < 3; ++k) {
-    const double radius =
-        std::abs(c(k, 0)) + std::abs(c(k, 1)) + std::abs(c(k, 2)) - std::abs(c(k, k));
-    lo = std::min(lo, c(k, k) - radius);
-    hi = std::max(hi, c(k, k) + radius);
-  }
-  return lo > 0.0 && stretch_lo_ * stretch_lo_ < lo && hi < stretch_hi_ * stretch_hi_;
+  if (std::isfinite(band.hi) && !IsPositiveDefinite(band.hi * band.hi * Mat3::Identity() - c))
+    return false;
+  return IsPositiveDefinite(c - band.lo * band.lo * Mat3::Identity());
 }
 
 int StrainLimitSource::AppendRows(const VecX& x, int body_index, std::vector<ConstraintRow>& rows) {
@@ -62,7 +82,7 @@ int StrainLimitSource::AppendRows(const VecX& x, int body_index, std::vector<Con
   for (int e = 0; e < tets_.num_elements(); ++e) {
     element_rows_.clear();
     const auto xe = tets_.GatherElement(x, e);
-    if (IsSurelyInactive(xe, e)) continue;
+    if (IsSurelyInside(xe, e, active_band_)) continue;
     const TetRestRows& r = tets_.rest().elements[e].r;
     const SignedSvd& svd = RememberSvd(e, xe, CalcSignedSvd(CalcTetDeformationGradient(r, xe)));
     if (AppendStrainLimitRows(e, r, svd, SelectStrainLimitFrame(settings_, e), params_,
@@ -150,7 +170,7 @@ SignedSvd StrainLimitSource::FindOrCalcSvd(int e, const TetPositions& xe) const 
 
 double StrainLimitSource::CalcElementViolation(const VecX& x, int e) const {
   const auto xe = tets_.GatherElement(x, e);
-  if (IsSurelyInactive(xe, e)) return 0.0;
+  if (IsSurelyInside(xe, e, violation_band_)) return 0.0;
   return CalcStrainLimitViolation(tets_.rest().elements[e].r, xe,
                                   SelectStrainLimitFrame(settings_, e), params_);
 }

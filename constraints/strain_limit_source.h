@@ -36,10 +36,16 @@ class StrainLimitSource final : public BodyConstraintSource {
  private:
   // Largest violation of element e at x.
   double CalcElementViolation(const VecX& x, int e) const;
-  // True when element e (positions xe) certainly has no active row: all its principal stretches
-  // (bounded by Gershgorin discs of F^T F) lie well inside the limits (hyperbolic and ellipsoid
-  // modes; the bound is in the constructor). Saves the SVD of untouched elements.
-  bool IsSurelyInactive(const std::array<Vec3, 4>& xe, int e) const;
+  // Principal stretches strictly inside (lo, hi) give every row of an element C > tau.
+  struct StretchBand {
+    double lo = 0.0;
+    double hi = HUGE_VAL;
+  };
+  // The band of activation margin tau (hyperbolic and ellipsoid modes, floor included).
+  StretchBand CalcStretchBand(double tau) const;
+  // True when every principal stretch of element e (positions xe) lies inside `band`, tested
+  // exactly on F^T F without an SVD: then no row of the element has C below the band's tau.
+  bool IsSurelyInside(const std::array<Vec3, 4>& xe, int e, const StretchBand& band) const;
 
   // The SVD of element e at positions xe, kept for the curvature at the same positions.
   const SignedSvd& RememberSvd(int e, const TetPositions& xe, const SignedSvd& svd);
@@ -58,10 +64,11 @@ class StrainLimitSource final : public BodyConstraintSource {
   const TetElementModel& tets_;
   StrainLimitSettings settings_;
   StrainLimitParams params_;
-  RowKeyPacker<4> key_;                              // kStrainLimitRowKey with this source's id
-  std::vector<StrainLimitRow> element_rows_;         // scratch, reused
-  bool screen_ = false;                              // IsSurelyInactive applies
-  double stretch_lo_ = 0.0, stretch_hi_ = HUGE_VAL;  // stretches that certainly emit no row
+  RowKeyPacker<4> key_;                       // kStrainLimitRowKey with this source's id
+  std::vector<StrainLimitRow> element_rows_;  // scratch, reused
+  bool screen_ = false;         // IsSurelyInside applies (hyperbolic and ellipsoid modes)
+  StretchBand active_band_;     // no row: C > activation margin
+  StretchBand violation_band_;  // no violation: C > 0
 };
 
 // The name of earlier releases, kept so that code written against them still compiles.

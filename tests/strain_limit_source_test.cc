@@ -351,5 +351,54 @@ TEST(StrainLimitSourceTest, HyperbolicBandGivesTheSameStateAsAllRows) {
   EXPECT_LT(violation_full, 1e-2);
 }
 
+// The screen that skips an element's SVD (all principal stretches inside the band where no row
+// reaches C < tau, resp. C < 0, tested exactly on F^T F) changes nothing: on a bent and twisted
+// beam across the limits, the source's rows, violation sum and largest violation equal those of
+// every element evaluated with its SVD, for isotropic, per-axis hyperbolic (compress, stretch
+// and the floor) and stretch-only limits.
+TEST(StrainLimitSourceTest, ScreenedElementsHaveNoRowAndNoViolation) {
+  auto body = MakeTetBox(Vec3(1.0, 0.2, 0.2), 10, 2, 2);
+  const TetElementModel& tets = *body->model().tet_model();
+  StrainLimitSettings floor_only = StrainLimitSettings::PerAxis(
+      Vec3(0.0, 0.0, 0.0), Vec3(kInf, 1.02, kInf), StrainProjection::kHyperbolic);
+  floor_only.inversion_floor = 0.9;  // rows below s_i = 0.92
+  const std::vector<StrainLimitSettings> all = {
+      StrainLimitSettings::Isotropic(0.96, 1.04),
+      StrainLimitSettings::PerAxis(Vec3(0.95, 0.96, 0.97), Vec3(1.05, 1.04, 1.03)), floor_only};
+  int checked_rows = 0, skipped_somewhere = 0;
+  for (const StrainLimitSettings& settings : all) {
+    const StrainLimitParams params = CalcStrainLimitParams(settings);
+    for (const double R : {1.2, 2.0, 3.0, 6.0, 20.0}) {
+      const VecX x = BentTwisted(*body, R, 0.3);
+      StrainLimitSource source(*body, settings, kSource);
+      std::vector<ConstraintRow> rows;
+      source.AppendRows(x, 0, rows);
+      std::vector<StrainLimitRow> expected;
+      double sum = 0.0, max = 0.0;
+      int elements_without_rows = 0;
+      for (int e = 0; e < tets.num_elements(); ++e) {
+        const TetPositions xe = tets.GatherElement(x, e);
+        const TetRestRows& r = tets.rest().elements[e].r;
+        const Mat3& Q = SelectStrainLimitFrame(settings, e);
+        if (AppendStrainLimitRows(e, r, xe, Q, params, &expected) == 0) ++elements_without_rows;
+        const double violation = CalcStrainLimitViolation(r, xe, Q, params);
+        sum += violation;
+        max = std::max(max, violation);
+      }
+      ASSERT_EQ(rows.size(), expected.size()) << "R = " << R;
+      for (size_t c = 0; c < rows.size(); ++c) {
+        EXPECT_EQ(rows[c].C, expected[c].C);
+        EXPECT_EQ(RowKeyPayload(rows[c].key), expected[c].key.Pack());
+      }
+      EXPECT_EQ(source.CalcViolationSum(x), sum) << "R = " << R;
+      EXPECT_EQ(source.CalcMaxViolation(x), max) << "R = " << R;
+      checked_rows += static_cast<int>(rows.size());
+      skipped_somewhere += elements_without_rows > 0 && !rows.empty();
+    }
+  }
+  EXPECT_GT(checked_rows, 0);
+  EXPECT_GT(skipped_somewhere, 0);  // states with rows on some elements and none on others
+}
+
 }  // namespace
 }  // namespace taut
