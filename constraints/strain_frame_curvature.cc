@@ -181,11 +181,11 @@ Mat9 CalcPrincipalStrainRowCurvature(const SignedSvd& svd, const Mat3& Q,
   return sigma * H;
 }
 
-Mat9 ClampNegativeModes(const Mat9& H) {
-  // Most elements' sums are already PSD: a Cholesky factor of H + delta I (9^3/3 flops, a tenth
-  // of the eigen-decomposition) proves lambda_min(H) > -delta, and H is kept as it is (its
-  // eigenvalues in (-delta, 0) are left unclamped: a change of delta = 1e-10 max |H_kk|).
-  const double delta = 1e-10 * H.diagonal().cwiseAbs().maxCoeff();
+Mat9 ClampNegativeModes(const Mat9& H, double kept_fraction) {
+  // A Cholesky factor of H + delta I (9^3/3 flops, a tenth of the eigen-decomposition) proves
+  // lambda_min(H) > -delta, delta = kept_fraction max |H_kk|, and H is kept as it is (its
+  // eigenvalues in (-delta, 0) are left unclamped).
+  const double delta = kept_fraction * H.diagonal().cwiseAbs().maxCoeff();
   if (delta > 0.0) {
     const Eigen::LLT<Mat9> cholesky(H + delta * Mat9::Identity());
     if (cholesky.info() == Eigen::Success) return H;

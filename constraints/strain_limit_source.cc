@@ -121,8 +121,9 @@ void StrainLimitSource::AddIslandCurvature(const IslandIterate& iterate, const C
   const auto flush = [&] {
     if (element < 0) return;
     if (full_curvature) {
-      sum = MapPrincipalHessianToTet(ClampNegativeModes(principal_sum), svd,
-                                     tets_.rest().elements[element].r);
+      sum = MapPrincipalHessianToTet(
+          ClampNegativeModes(principal_sum, kFrameCurvatureKeptNegativeFraction), svd,
+          tets_.rest().elements[element].r);
     }
     sink.AddElementBlock(body, element, tets_.element_nodes(element), sum);
   };

@@ -7,6 +7,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <random>
@@ -227,6 +228,31 @@ TEST(StrainFrameCurvatureClampTest, KeepsThePositivePartOnly) {
     const Eigen::SelfAdjointEigenSolver<Mat9> of_negative(ClampNegativeModes(negative));
     EXPECT_GT(of_negative.eigenvalues().minCoeff(), -1e-12 * scale);
   }
+}
+
+// With kept_fraction f, a sum whose eigenvalues all exceed -f max |H_kk| is kept whole (the
+// source keeps the frame curvature's mildly indefinite element sums, docs/math.md §5.9); one with
+// a mode below that is clamped to its PSD part.
+TEST(StrainFrameCurvatureClampTest, KeepsModesAboveTheKeptFraction) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> n;
+  Mat9 A;
+  for (int k = 0; k < 81; ++k) A.data()[k] = n(rng);
+  const Eigen::HouseholderQR<Mat9> qr(A);
+  const Mat9 Q = qr.householderQ();
+  using Vec9 = Eigen::Matrix<double, 9, 1>;
+  Vec9 mild = Vec9::Ones(), strong = Vec9::Ones();
+  mild[8] = -0.2;    // max |H_kk| >= 0.4 (a convex combination of the eigenvalues, mostly 1)
+  strong[8] = -0.9;  // below -0.5 max |H_kk| (max |H_kk| <= 1)
+  const Mat9 H_mild = Q * mild.asDiagonal() * Q.transpose();
+  const Mat9 H_strong = Q * strong.asDiagonal() * Q.transpose();
+  ASSERT_GT(H_mild.diagonal().cwiseAbs().maxCoeff(), 0.4);
+  EXPECT_TRUE(ClampNegativeModes(H_mild, kFrameCurvatureKeptNegativeFraction) == H_mild);
+  EXPECT_FALSE(ClampNegativeModes(H_mild) == H_mild);  // the exact clamp removes -0.2
+  const Mat9 clamped = ClampNegativeModes(H_strong, kFrameCurvatureKeptNegativeFraction);
+  Vec9 psd = strong;
+  psd[8] = 0.0;
+  EXPECT_LT((clamped - Q * psd.asDiagonal() * Q.transpose()).norm(), 1e-12);
 }
 
 }  // namespace
