@@ -39,7 +39,11 @@ struct ConstraintRow {
   // 0 for unilateral rows. A friction row targets J v = 0 within the Coulomb disk of radius
   // mu lambda_n; its C is unused.
   int friction_of = 0;
-  double mu = 0.0;                        // Coulomb coefficient of a friction row
+  double mu = 0.0;  // Coulomb coefficient of a friction row
+  // The row's curvature term (CollectCurvature) is its full second derivative, frame factor
+  // included (strain rows of docs/math.md §5.9): the primal path's inner solves converge on it,
+  // so a stalled complementarity residual is the multiplier iteration's (penalty growth, §5.8).
+  bool full_curvature = false;
   std::array<int, kMaxRowNodes> nodes{};  // node indices in the body
   std::array<Vec3, kMaxRowNodes> J{};     // dC/dx_node
   int body2 = -1;                         // side B's body in the island, -1 when one-sided

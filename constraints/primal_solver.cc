@@ -81,8 +81,12 @@ void PrimalSolver::CalcPenalties(const std::vector<IslandBody*>& bodies,
 void PrimalSolver::GrowStalledPenalties(const PrimalSettings& settings, double tolerance) {
   // A limit row still violated by more than the tolerance whose violation fell by less than half
   // over the last multiplier iteration has its rho multiplied by penalty_growth, up to
-  // max_penalty_growth times its Delassus value (docs/math.md §5.8, penalty growth). rho_ holds
-  // the kept, already grown, penalties of the last multiplier iteration.
+  // max_penalty_growth times its Delassus value (docs/math.md §5.8, penalty growth). Once the
+  // iterate is feasible, a row with full curvature that pushes (lambda_bar > 0) while slack by
+  // more than the tolerance counts its complementarity residual C the same way: its multiplier
+  // falls by only rho C / h per iteration. rho_ holds the kept, already grown, penalties of the
+  // last multiplier iteration.
+  const bool feasible = settings.grow_on_slack_push && violation_ <= tolerance;
   const int m = rows_.size();
   last_.setConstant(m, -1.0);
   growth_.setOnes(m);
@@ -92,7 +96,9 @@ void PrimalSolver::GrowStalledPenalties(const PrimalSettings& settings, double t
   kept_growth_.clear();
   for (int c = 0; c < m; ++c) {
     if (!IsLimitRow(rows_[c])) continue;
-    const double violation = std::max(0.0, -rows_[c].C);
+    const bool pushing_while_slack =
+        feasible && rows_[c].full_curvature && lambda_bar_[c] > 0.0 && rows_[c].C > 0.0;
+    const double violation = pushing_while_slack ? rows_[c].C : std::max(0.0, -rows_[c].C);
     if (violation > tolerance && last_[c] >= 0.0 && violation > 0.5 * last_[c]) {
       const double next =
           std::min(growth_[c] * settings.penalty_growth, settings.max_penalty_growth);

@@ -125,10 +125,10 @@ class PrimalSolver {
   VecX rho_, g0_, jv_, s_;     // penalties, g_c(v) = g0 + J v, J v, J d
   KeyedMultipliers kept_rho_;  // limit rows' rho of this multiplier iteration by key
   bool rho_kept_ = false;
-  KeyedMultipliers last_violation_;      // limit rows' max(0, -C) at the last multiplier iteration
-  KeyedMultipliers kept_growth_;         // limit rows' rho growth (> 1) of this step by key
-  VecX last_, growth_;                   // the two by row (scratch)
-  VecX d_unit_;                          // D_c of scalar rows (0 or 1)
+  KeyedMultipliers last_violation_;  // limit rows' stall residual at the last multiplier iteration
+  KeyedMultipliers kept_growth_;     // limit rows' rho growth (> 1) of this step by key
+  VecX last_, growth_;               // the two by row (scratch)
+  VecX d_unit_;                      // D_c of scalar rows (0 or 1)
   std::vector<Eigen::Matrix2d> d_disk_;  // D of a friction pair, on its first tangent row
   std::vector<char> in_pattern_;         // row's same-body blocks fit the patterns
   bool coupled_ = false;                 // some row is two-sided or off-pattern: PCG

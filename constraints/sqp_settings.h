@@ -25,6 +25,9 @@ struct PrimalSettings {
   // iteration gets penalty_growth times its rho, up to max_penalty_growth times (1 = off).
   double penalty_growth = 3.0;
   double max_penalty_growth = 10.0;
+  // ... and, once the iterate is feasible, a row with full curvature that pushes while slack by
+  // more than the tolerance, by its complementarity residual C (docs/math.md §5.8).
+  bool grow_on_slack_push = true;
   double newton_tolerance = 1e-9;  // stop when the Newton decrement < this * ||v - v*||_A^2
   // ... or as soon as (v, Proj(y(v))) passes the step's certificate after a Newton step, with
   // distance rows (contacts, joints) held to newton_stop_distance_factor of their tolerance.

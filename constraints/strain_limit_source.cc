@@ -23,6 +23,7 @@ StrainLimitSource::StrainLimitSource(const DeformableBody& body,
     : body_(body), tets_(AsTets(body)), settings_(settings), key_(kStrainLimitRowKey, source_id) {
   settings_.Validate(tets_.num_elements(), "body '" + body.name() + "' strain limits");
   params_ = CalcStrainLimitParams(settings_);
+  full_curvature_ = HasStrainFrameCurvature(params_);
   // Hyperbolic and ellipsoid rows of principal axis i have C = 1 - kappa_eff (s_i - 1) with
   // kappa_eff <= max_j kappa^j (|V'_ji| <= 1; ||K w|| <= max kappa), so no row of an element is
   // active (C < tau) while every stretch lies in [1 - (1-tau)/max kappa_min,
@@ -96,6 +97,7 @@ int StrainLimitSource::AppendRows(const VecX& x, int body_index, std::vector<Con
       row.body = body_index;
       row.element = e;
       row.type = RowType::kStrainLimit;
+      row.full_curvature = full_curvature_;
       row.num_nodes = 4;
       for (int n = 0; n < 4; ++n) {
         row.nodes[n] = nodes[n];
@@ -113,7 +115,7 @@ void StrainLimitSource::AddIslandCurvature(const IslandIterate& iterate, const C
   // scattered once (16 node blocks per element, not per row). Frame-dependent rows sum their
   // full curvature over vec(P) and clamp the element's sum once (docs/math.md §5.9); the others
   // clamp each row's stretch term (§5.9).
-  const bool full_curvature = HasStrainFrameCurvature(params_);
+  const bool full_curvature = full_curvature_;
   int element = -1, body = -1;
   SignedSvd svd;
   Mat12 sum = Mat12::Zero();

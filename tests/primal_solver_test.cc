@@ -182,6 +182,48 @@ TEST(PrimalSolverTest, StalledLimitRowsGetLargerPenaltiesAndConverge) {
   EXPECT_LE(worst, 1e-3);
 }
 
+TEST(PrimalSolverTest, FrameCurvatureHalvesTheAnisotropicBeamsNewtonIterations) {
+  // The soft anisotropic beam (240 tets): its rows depend on the principal frame, and without
+  // the frame factor's second derivative the Newton matrix underestimates Phi's curvature along
+  // the step 3-15x (the line search halves alpha in 60 % of the steps; docs/math.md §5.9).
+  int newton[2] = {0, 0}, unconverged[2] = {0, 0};
+  for (const bool frame : {false, true}) {
+    TetBeamScene::Beam beam = TetBeamScene::DefaultBeams()[2];
+    beam.limits->full_frame_curvature = frame;
+    TetBeamScene scene({beam});
+    scene.world().mutable_solver_settings().solver = IslandSolverKind::kPrimal;
+    for (int step = 0; step < 120; ++step) {
+      scene.world().stepSimulation(1.0 / 240.0, 1, 1.0 / 240.0);
+      if (step < 60) continue;  // counted once the beam swings in its limits
+      newton[frame] += scene.world().last_step_stats().newton_iterations;
+      unconverged[frame] += scene.world().last_step_stats().converged ? 0 : 1;
+    }
+  }
+  std::printf("steps 60-119, Newton iterations: stretch term %d, with the frame factor %d\n",
+              newton[0], newton[1]);
+  EXPECT_EQ(unconverged[0], 0);
+  EXPECT_EQ(unconverged[1], 0);
+  EXPECT_LT(newton[1], 0.75 * newton[0]);
+}
+
+TEST(PrimalSolverTest, SlackPushingRowsGetLargerPenaltiesAndConverge) {
+  // The tet_beam scene (four 240-tet beams, auto path): in step 106 the anisotropic beam's
+  // iterate is feasible and stationary, but one row pushes while 0.12 % inside its limit and its
+  // multiplier falls only ~3 % per multiplier iteration, past the 40-iteration cap (and the dual
+  // retry fails too). Growing that row's rho (PrimalSettings::grow_on_slack_push) certifies it.
+  int unconverged[2] = {0, 0};
+  for (const bool grow : {false, true}) {
+    TetBeamScene scene(TetBeamScene::DefaultBeams());
+    scene.world().mutable_solver_settings().primal.grow_on_slack_push = grow;
+    for (int step = 0; step < 110; ++step) {
+      scene.world().stepSimulation(1.0 / 240.0, 1, 1.0 / 240.0);
+      unconverged[grow] += scene.world().last_step_stats().converged ? 0 : 1;
+    }
+  }
+  EXPECT_GT(unconverged[0], 0);
+  EXPECT_EQ(unconverged[1], 0);
+}
+
 TEST(PrimalSolverTest, KeptFactorsGiveTheStepsOfFreshFactors) {
   // Factor reuse only changes how the Newton step is solved (CG on the exact H, preconditioned by
   // an earlier factor): the certified answer is the same, with fewer factorizations.
