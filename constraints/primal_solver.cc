@@ -86,7 +86,7 @@ void PrimalSolver::GrowStalledPenalties(const PrimalSettings& settings, double t
   // more than the tolerance counts its complementarity residual C the same way: its multiplier
   // falls by only rho C / h per iteration. rho_ holds the kept, already grown, penalties of the
   // last multiplier iteration.
-  const bool feasible = settings.grow_on_slack_push && violation_ <= tolerance;
+  const bool count_slack_push = settings.grow_on_slack_push && violation_ <= tolerance;
   const int m = rows_.size();
   last_.setConstant(m, -1.0);
   growth_.setOnes(m);
@@ -97,7 +97,7 @@ void PrimalSolver::GrowStalledPenalties(const PrimalSettings& settings, double t
   for (int c = 0; c < m; ++c) {
     if (!IsLimitRow(rows_[c])) continue;
     const bool pushing_while_slack =
-        feasible && rows_[c].full_curvature && lambda_bar_[c] > 0.0 && rows_[c].C > 0.0;
+        count_slack_push && rows_[c].full_curvature && lambda_bar_[c] > 0.0 && rows_[c].C > 0.0;
     const double violation = pushing_while_slack ? rows_[c].C : std::max(0.0, -rows_[c].C);
     if (violation > tolerance && last_[c] >= 0.0 && violation > 0.5 * last_[c]) {
       const double next =

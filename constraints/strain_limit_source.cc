@@ -24,16 +24,12 @@ StrainLimitSource::StrainLimitSource(const DeformableBody& body,
   settings_.Validate(tets_.num_elements(), "body '" + body.name() + "' strain limits");
   params_ = CalcStrainLimitParams(settings_);
   full_curvature_ = HasStrainFrameCurvature(params_);
-  // Hyperbolic and ellipsoid rows of principal axis i have C = 1 - kappa_eff (s_i - 1) with
-  // kappa_eff <= max_j kappa^j (|V'_ji| <= 1; ||K w|| <= max kappa), so no row of an element is
-  // active (C < tau) while every stretch lies in [1 - (1-tau)/max kappa_min,
-  // 1 + (1-tau)/max kappa_max], and above the floor's activation (below).
-  screen_ = params_.projection == StrainProjection::kHyperbolic ||
-            params_.projection == StrainProjection::kEllipsoid;
-  // Rows are emitted below C = tau (the activation band); a violation needs C < 0 (the wider
-  // band of tau = 0).
+  // Hyperbolic and ellipsoid rows bound their C by the stretches alone (CalcStretchBand): rows
+  // are emitted below C = tau (the activation band), a violation needs C < 0 (tau = 0).
   const double tau = params_.activation_margin;
-  screen_ = screen_ && std::isfinite(tau) && tau < 1.0;
+  screen_ = (params_.projection == StrainProjection::kHyperbolic ||
+             params_.projection == StrainProjection::kEllipsoid) &&
+            std::isfinite(tau) && tau < 1.0;
   if (screen_) {
     active_band_ = CalcStretchBand(tau);
     violation_band_ = CalcStretchBand(0.0);
@@ -41,7 +37,8 @@ StrainLimitSource::StrainLimitSource(const DeformableBody& body,
 }
 
 StrainLimitSource::StretchBand StrainLimitSource::CalcStretchBand(double tau) const {
-  // Every row of principal axis i has C >= 1 - max_j kappa^j |s_i - 1| (> tau inside the band);
+  // Every row of principal axis i has C >= 1 - max_j kappa^j |s_i - 1| (kappa_eff <= max_j kappa^j:
+  // |V'_ji| <= 1, ||K w|| <= max kappa), so C > tau inside the band;
   // floor rows C = (s_i - f) / (1 - f) exceed tau above s_i = f + tau (1 - f) (docs/math.md §3.8).
   const double slack = 1.0 - tau;
   StretchBand band;
@@ -115,14 +112,13 @@ void StrainLimitSource::AddIslandCurvature(const IslandIterate& iterate, const C
   // scattered once (16 node blocks per element, not per row). Frame-dependent rows sum their
   // full curvature over vec(P) and clamp the element's sum once (docs/math.md §5.9); the others
   // clamp each row's stretch term (§5.9).
-  const bool full_curvature = full_curvature_;
   int element = -1, body = -1;
   SignedSvd svd;
   Mat12 sum = Mat12::Zero();
   Mat9 principal_sum = Mat9::Zero();
   const auto flush = [&] {
     if (element < 0) return;
-    if (full_curvature) {
+    if (full_curvature_) {
       sum = MapPrincipalHessianToTet(
           ClampNegativeModes(principal_sum, kFrameCurvatureKeptNegativeFraction), svd,
           tets_.rest().elements[element].r);
@@ -143,7 +139,7 @@ void StrainLimitSource::AddIslandCurvature(const IslandIterate& iterate, const C
       svd = FindOrCalcSvd(element, tets_.GatherElement(iterate.x(row.body), element));
     }
     const Mat3& Q = SelectStrainLimitFrame(settings_, element);
-    if (full_curvature) {
+    if (full_curvature_) {
       principal_sum.noalias() += weights[c] * CalcPrincipalStrainRowCurvature(svd, Q, params_, key);
     } else {
       sum.noalias() += weights[c] * CalcStrainLimitRowCurvature(r, svd, Q, params_, key);
