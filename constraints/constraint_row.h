@@ -44,6 +44,10 @@ struct ConstraintRow {
   // included (strain rows of docs/math.md §5.9): the primal path's inner solves converge on it,
   // so a stalled complementarity residual is the multiplier iteration's (penalty growth, §5.8).
   bool full_curvature = false;
+  // The row's curvature term is its whole second derivative (full_curvature rows, and ellipsoid
+  // rows of equal axis limits, whose C depends on one stretch only): the primal path's model of
+  // Phi is trusted for model steps (docs/math.md §5.8, model steps).
+  bool exact_curvature = false;
   std::array<int, kMaxRowNodes> nodes{};  // node indices in the body
   std::array<Vec3, kMaxRowNodes> J{};     // dC/dx_node
   int body2 = -1;                         // side B's body in the island, -1 when one-sided

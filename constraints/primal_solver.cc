@@ -436,10 +436,9 @@ void PrimalSolver::CalcSlope(double alpha, double a0, double a1, double& slope,
   }
 }
 
-double PrimalSolver::SearchModelLine(const std::vector<IslandBody*>& bodies) {
+double PrimalSolver::SearchModelLine(const std::vector<IslandBody*>& bodies, double a0) {
   const size_t nb = bodies.size();
-  // a0 = d^T A(v - v*) (A(v - v*) from the gradient), a1 = d^T (A + G) d, s_c = J_c d.
-  const double a0 = Dot(d_, aw_);
+  // a0 = d^T A(v - v*) (+ d^T G (v - v_lin) on a model step), a1 = d^T (A + G) d, s_c = J_c d.
   for (size_t b = 0; b < nb; ++b) bodies[b]->ApplySystemMatrix(d_[b], hp_[b]);
   line_dAd_ = Dot(d_, hp_);
   line_a0_ = a0;
@@ -526,6 +525,79 @@ void PrimalSolver::CollectRowsAt(double h, const std::vector<IslandBody*>& bodie
   stats.ms_rows += MsSince(t);
 }
 
+double PrimalSolver::CalcModelMerit(const std::vector<IslandBody*>& bodies) {
+  const size_t nb = bodies.size();
+  double energy = 0.0;
+  for (size_t b = 0; b < nb; ++b) {
+    work_[b] = v_[b] - bodies[b]->v_star();
+    bodies[b]->ApplySystemMatrix(work_[b], hp_[b]);
+    energy += 0.5 * work_[b].dot(hp_[b]);
+    work_[b] = v_[b] - model_base_[b];
+    model_gw_[b].setZero(work_[b].size());
+  }
+  curvature_.AddTimes(work_, model_gw_);
+  for (size_t b = 0; b < nb; ++b)
+    for (int i = 0; i < bodies[b]->num_blocks(); ++i)
+      if (!bodies[b]->is_free_block(i)) model_gw_[b].segment<3>(3 * i).setZero();
+  return energy + 0.5 * Dot(work_, model_gw_) + CalcRowMerit(v_);
+}
+
+double PrimalSolver::StepOnModel(double alpha, const std::vector<IslandBody*>& bodies,
+                                 const PrimalSettings& settings, StepStats& stats) {
+  // The model keeps the rows, rho, lambda_bar and G of v_lin: g_c(u) = g0_c + J_c u (g0_ holds),
+  // so Proj(y(u)), D and grad Phi at u are the plain ones plus G (u - v_lin). Only D changes
+  // from H's: PCG preconditioned by H's factor solves it in a few iterations.
+  const size_t nb = bodies.size();
+  model_base_ = v_;
+  model_gw_.resize(nb);
+  const double phi_start = CalcModelMerit(bodies);
+  for (size_t b = 0; b < nb; ++b) v_[b] += alpha * d_[b];
+  const bool refactor_next = refactor_next_;
+  for (int step = 0; step < settings.max_model_steps && alpha < settings.model_step_alpha; ++step) {
+    CalcProjectedMultipliers();
+    CalcGradient(bodies);
+    CalcModelMerit(bodies);  // for model_gw_ = G (v - v_lin)
+    for (size_t b = 0; b < nb; ++b) grad_[b] += model_gw_[b];
+    any_stale_ = true;
+    stale_.assign(nb, 1);
+    stale_budget_ = settings.model_pcg_iterations;
+    stats.pcg_iterations += SolveNewtonStep(bodies, settings);
+    if (!(Dot(grad_, d_) < 0.0)) break;
+    alpha = SearchModelLine(bodies, Dot(d_, aw_) + Dot(d_, model_gw_));
+    if (alpha <= 0.0) break;
+    for (size_t b = 0; b < nb; ++b) v_[b] += alpha * d_[b];
+  }
+  refactor_next_ = refactor_next;  // the PCG budget here says nothing about H's factor
+  const double decrease = phi_start - CalcModelMerit(bodies);
+  v_trial_ = v_;
+  v_ = model_base_;
+  return decrease;
+}
+
+bool PrimalSolver::TryModelSteps(double h, double alpha, double phi0,
+                                 const std::vector<IslandBody*>& bodies,
+                                 const std::vector<ConstraintSource*>& sources,
+                                 const SqpSettings& settings, StepStats& stats) {
+  const double decrease = StepOnModel(alpha, bodies, settings.primal, stats);
+  if (!(decrease > 0.0)) return false;
+  CollectRowsAt(h, bodies, sources, v_trial_, settings, stats);
+  double energy = 0.0;
+  for (size_t b = 0; b < bodies.size(); ++b) {
+    work_[b] = v_trial_[b] - bodies[b]->v_star();
+    bodies[b]->ApplySystemMatrix(work_[b], hp_[b]);
+    energy += 0.5 * work_[b].dot(hp_[b]);
+  }
+  // Sufficient decrease against the model's decrease (the plain step: alpha times the decrement).
+  // Phi fell by less than half the model's prediction: the linearization is poor here (rows that
+  // flip, kinks of the principal stretches), and model steps wander on it; the rest of the step
+  // takes plain Newton steps.
+  const double phi = energy + CalcRowMerit(v_trial_);
+  if (phi0 - phi < 0.5 * decrease) model_steps_off_ = true;
+  if (phi <= phi0 - 1e-4 * decrease) return true;
+  base_.Restore(*this);
+  return false;
+}
+
 bool PrimalSolver::TakeNewtonStep(double h, const std::vector<IslandBody*>& bodies,
                                   const std::vector<ConstraintSource*>& sources,
                                   const SqpSettings& settings, StepStats& stats) {
@@ -546,13 +618,24 @@ bool PrimalSolver::TakeNewtonStep(double h, const std::vector<IslandBody*>& bodi
   const double decrement = -Dot(grad_, d_);
   const double scale = Dot(w_, aw_);
   if (!(decrement > primal.newton_tolerance * std::max(scale, 1e-300))) return false;
-  double alpha = SearchModelLine(bodies);
+  double alpha = SearchModelLine(bodies, Dot(d_, aw_));
   if (alpha <= 0.0) return false;
   // Armijo backtracking on the nonlinear Phi (rows re-evaluated at each trial). With w = v - v*
   // the energy at v + alpha d is 1/2 w^T A w + alpha d^T A w + alpha^2/2 d^T A d (scale = w^T A w
   // and the two products of the model line search): no product with A per trial.
   const double phi0 = 0.5 * scale + CalcRowMerit(v_);
   base_.Save(*this);
+  if (primal.max_model_steps > 0 && alpha < primal.model_step_alpha && !model_steps_off_ &&
+      std::all_of(rows_.rows().begin(), rows_.rows().end(), [](const ConstraintRow& row) {
+        return !IsLimitRow(row) || row.exact_curvature;
+      })) {
+    model_d0_ = d_;
+    const double line_a0 = line_a0_, line_dAd = line_dAd_;
+    if (TryModelSteps(h, alpha, phi0, bodies, sources, settings, stats)) return true;
+    d_ = model_d0_;  // the plain step along the first direction
+    line_a0_ = line_a0;
+    line_dAd_ = line_dAd;
+  }
   for (int halving = 0;; ++halving) {
     for (size_t b = 0; b < nb; ++b) v_trial_[b] = base_.v[b] + alpha * d_[b];
     CollectRowsAt(h, bodies, sources, v_trial_, settings, stats);
@@ -576,6 +659,7 @@ bool PrimalSolver::IsNewtonIterateCertified(const std::vector<IslandBody*>& bodi
   // Distance rows (contacts, joints) must hold to newton_stop_distance_factor of their
   // tolerance: a sticking contact may slip h |J_t v| <= tolerance in every step, and a rigid stack
   // stopped at the tolerance crept 15 mm in 2 s where the exact solve holds it.
+  if (violation_ > settings.violation_tolerance) return false;  // its primal residual
   CalcProjectedMultipliers();
   const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
   newton_kkt_ = CalcKktResidualsWithRefit(
@@ -655,6 +739,7 @@ void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
   iterate_ = settings.warm_start ? warm : KeyedMultipliers();
   rho_kept_ = false;
   newton_certified_ = false;
+  model_steps_off_ = false;
   last_violation_.clear();
   kept_growth_.clear();
   refactor_next_ = false;  // a factor kept from the previous step may precondition this one

@@ -82,6 +82,19 @@ class PrimalSolver {
                         const std::vector<ConstraintSource*>& sources);
   // Stage: one Newton step on Phi from v_ (rows collected at v_); returns false when v_ is
   // stationary (Newton decrement below tolerance) and nothing moved.
+  // Newton steps on the model of the rows linearized at v (docs/math.md §5.8, model steps), from
+  // v + alpha d while the model line search stops below settings.model_step_alpha. The end point
+  // is left in v_trial_ (v_ is restored); returns the decrease of the model's Phi.
+  double StepOnModel(double alpha, const std::vector<IslandBody*>& bodies,
+                     const PrimalSettings& settings, StepStats& stats);
+  // Phi of the model at v_: 1/2 ||v - v*||_A^2 + 1/2 (v - v_lin)^T G (v - v_lin) + the rows'
+  // terms with g_c linear in v (v_lin = model_base_); sets model_gw_ = G (v - v_lin).
+  double CalcModelMerit(const std::vector<IslandBody*>& bodies);
+  // StepOnModel from the line search's alpha, then the Armijo test at its end point against
+  // phi0 (rows evaluated there); false (the base point restored) when it fails.
+  bool TryModelSteps(double h, double alpha, double phi0, const std::vector<IslandBody*>& bodies,
+                     const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
+                     StepStats& stats);
   bool TakeNewtonStep(double h, const std::vector<IslandBody*>& bodies,
                       const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
                       StepStats& stats);
@@ -104,8 +117,9 @@ class PrimalSolver {
   // out = H u (exact operator, matrix-free rows).
   void ApplyHessian(const std::vector<IslandBody*>& bodies, const std::vector<VecX>& u,
                     std::vector<VecX>& out);
-  // Step length minimizing the linearized model of Phi along d (root of its convex slope).
-  double SearchModelLine(const std::vector<IslandBody*>& bodies);
+  // Step length minimizing the linearized model of Phi along d (root of its convex slope), with
+  // a0 = d^T grad of the model's quadratic part at v.
+  double SearchModelLine(const std::vector<IslandBody*>& bodies, double a0);
   // Slope psi'(alpha) and curvature psi''(alpha) of the linearized model along d.
   void CalcSlope(double alpha, double a0, double a1, double& slope, double& curvature) const;
   // Phi at the collected rows and velocities v (lambda_bar, rho as collected).
@@ -134,11 +148,14 @@ class PrimalSolver {
   bool coupled_ = false;                 // some row is two-sided or off-pattern: PCG
   std::vector<char> stale_;              // body keeps its last factor (ChooseFactorReuse)
   bool any_stale_ = false;
-  double stale_budget_ = 0.0;              // CG iterations a kept factor may take before a refactor
-  bool refactor_next_ = false;             // the last kept factor took too many: refactor
-  double violation_ = 0.0;                 // largest row violation at the collected rows
-  bool newton_certified_ = false;          // the Newton loop stopped on the certificate ...
-  KktResiduals newton_kkt_;                // ... with these residuals at (v, Proj(y(v)))
+  double stale_budget_ = 0.0;      // CG iterations a kept factor may take before a refactor
+  bool refactor_next_ = false;     // the last kept factor took too many: refactor
+  double violation_ = 0.0;         // largest row violation at the collected rows
+  bool newton_certified_ = false;  // the Newton loop stopped on the certificate ...
+  KktResiduals newton_kkt_;        // ... with these residuals at (v, Proj(y(v)))
+  // Model steps: the linearization point v_lin, G (v - v_lin), and the plain step kept aside.
+  std::vector<VecX> model_base_, model_gw_, model_d0_;
+  bool model_steps_off_ = false;  // a model step fell short of its model in this step (solve)
   double line_a0_ = 0.0, line_dAd_ = 0.0;  // d^T A (v - v*) and d^T A d of the model line search
   CurvatureMetric curvature_;
   VecX curvature_weights_;  // h lambda_c of the rows, for the sources' curvature

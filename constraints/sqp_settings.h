@@ -36,6 +36,14 @@ struct PrimalSettings {
   int max_pcg_iterations = 200;  // coupled islands: PCG on the Newton step
   double pcg_tolerance = 1e-10;  // relative residual of that PCG
   bool curvature = true;         // lagged row curvature G in the model and H
+  // Model steps: when the model line search stops short of the Newton step (alpha below
+  // model_step_alpha: a row turns active along d), up to max_model_steps further Newton steps on
+  // the same linearization (rows, rho and G fixed), by PCG preconditioned with this iteration's
+  // factor (at most model_pcg_iterations), before the rows are evaluated again; the end point
+  // must pass the same Armijo test, else the plain step is taken (docs/math.md §5.8, model steps).
+  int max_model_steps = 2;
+  double model_step_alpha = 0.5;
+  int model_pcg_iterations = 10;
   // Factor reuse: a body whose H costs more than min_refactor_cost preconditioned CG iterations
   // to factor keeps its last factor (from an earlier Newton iteration or step) as the
   // preconditioner of CG on the exact H, to stale_pcg_tolerance, while CG needs fewer than half

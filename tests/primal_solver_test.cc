@@ -206,6 +206,41 @@ TEST(PrimalSolverTest, FrameCurvatureHalvesTheAnisotropicBeamsNewtonIterations) 
   EXPECT_LT(newton[1], 0.75 * newton[0]);
 }
 
+TEST(PrimalSolverTest, ModelStepsCutTheIsotropicBeamsNewtonIterationsAndKeepItsPath) {
+  // The soft isotropic beam (240 tets, ellipsoid rows of equal limits: exact curvature). Where the
+  // model line search stops short because a row turns active along d, Newton steps on the same
+  // linearization replace full Newton iterations (rows, curvature and certificate evaluated
+  // again); the answer is the same certified one, so the tip follows the same path.
+  int newton[2] = {0, 0}, unconverged[2] = {0, 0};
+  double worst[2] = {0.0, 0.0};
+  Vec3 tip[2];
+  for (const int model : {0, 1}) {
+    TetBeamScene scene({TetBeamScene::DefaultBeams()[3]});
+    SqpSettings& settings = scene.world().mutable_solver_settings();
+    settings.solver = IslandSolverKind::kPrimal;
+    ASSERT_GT(settings.primal.max_model_steps, 0);  // on by default
+    if (model == 0) settings.primal.max_model_steps = 0;
+    for (int step = 0; step < 120; ++step) {
+      scene.world().stepSimulation(1.0 / 240.0, 1, 1.0 / 240.0);
+      const StepStats& stats = scene.world().last_step_stats();
+      newton[model] += stats.newton_iterations;
+      unconverged[model] += stats.converged ? 0 : 1;
+      worst[model] = std::max(worst[model], stats.violation_after);
+    }
+    tip[model] = scene.CalcTipDisplacement(0);
+  }
+  const double tip_gap = (tip[1] - tip[0]).norm();
+  std::printf(
+      "120 steps, Newton iterations: plain %d, with model steps %d; tip gap %.3g m (tip "
+      "displacement %.3g m)\n",
+      newton[0], newton[1], tip_gap, tip[0].norm());
+  EXPECT_EQ(unconverged[0], 0);
+  EXPECT_EQ(unconverged[1], 0);
+  EXPECT_LE(worst[1], 1e-3);
+  EXPECT_LT(newton[1], 0.8 * newton[0]);
+  EXPECT_LT(tip_gap, 0.01 * tip[0].norm());
+}
+
 TEST(PrimalSolverTest, SlackPushingRowsGetLargerPenaltiesAndConverge) {
   // The tet_beam scene (four 240-tet beams, auto path): in step 106 the anisotropic beam's
   // iterate is feasible and stationary, but one row pushes while 0.12 % inside its limit and its
