@@ -132,7 +132,7 @@ asan_long_tests+='|TetBodyRestsOnItsEmbeddedSurfaceInsteadOfItsBoundary|HangingC
 asan_long_tests+='|BoxOnASoftPadFeelsItsWeightAndThePadTheOpposite|SoftBlockRestingOnTheGroundReportsItsWeight'
 asan_long_tests+='|CrushedBlockKeepsEveryStretchAboveTheFloor|GripperScene|CapsuleRolledOverASoftSlab'
 asan_long_tests+='|AfterAFailedRetryTheIslandIsNotRetriedForAWhile|WarmStartVelocityKeepsThePresses'
-asan_long_tests+='|FrameCurvatureHalvesTheAnisotropicBeams|SlackPushingRowsGetLargerPenalties'
+asan_long_tests+='|FrameCurvatureHalvesTheAnisotropicBeams|SlackPushingRowsGetLargerPenalties|ModelStepsCutTheIsotropicBeams'
 
 # Stage 3: Debug build with AddressSanitizer + UBSan and its tests (without the long ones above).
 stage_asan() {
