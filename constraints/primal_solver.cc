@@ -364,7 +364,7 @@ void PrimalSolver::ApplyHessian(const std::vector<IslandBody*>& bodies, const st
 }
 
 int PrimalSolver::SolveNewtonStep(const std::vector<IslandBody*>& bodies,
-                                  const PrimalSettings& settings) {
+                                  const PrimalSettings& settings, bool model_step) {
   const size_t nb = bodies.size();
   // Local rows only and fresh factors: H = N, one solve per body.
   for (size_t b = 0; b < nb; ++b) {
@@ -376,8 +376,8 @@ int PrimalSolver::SolveNewtonStep(const std::vector<IslandBody*>& bodies,
   // kept factor: to the looser stale tolerance, within the refactor budget).
   const bool only_stale = any_stale_ && !coupled_;
   const double tolerance = any_stale_ ? settings.stale_pcg_tolerance : settings.pcg_tolerance;
-  const int max_iterations =
-      only_stale ? std::max(1, static_cast<int>(stale_budget_)) : settings.max_pcg_iterations;
+  const int max_iterations = only_stale || model_step ? std::max(1, static_cast<int>(stale_budget_))
+                                                      : settings.max_pcg_iterations;
   ApplyHessian(bodies, d_, hp_);
   for (size_t b = 0; b < nb; ++b) r_[b] = -grad_[b] - hp_[b];
   const double rhs_norm = std::sqrt(Dot(grad_, grad_));
@@ -561,7 +561,7 @@ double PrimalSolver::StepOnModel(double alpha, const std::vector<IslandBody*>& b
     any_stale_ = true;
     stale_.assign(nb, 1);
     stale_budget_ = settings.model_pcg_iterations;
-    stats.pcg_iterations += SolveNewtonStep(bodies, settings);
+    stats.pcg_iterations += SolveNewtonStep(bodies, settings, /*model_step=*/true);
     if (!(Dot(grad_, d_) < 0.0)) break;
     alpha = SearchModelLine(bodies, Dot(d_, aw_) + Dot(d_, model_gw_));
     if (alpha <= 0.0) break;
