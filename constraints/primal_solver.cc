@@ -364,7 +364,7 @@ void PrimalSolver::ApplyHessian(const std::vector<IslandBody*>& bodies, const st
 }
 
 int PrimalSolver::SolveNewtonStep(const std::vector<IslandBody*>& bodies,
-                                  const PrimalSettings& settings, bool model_step) {
+                                  const PrimalSettings& settings) {
   const size_t nb = bodies.size();
   // Local rows only and fresh factors: H = N, one solve per body.
   for (size_t b = 0; b < nb; ++b) {
@@ -376,8 +376,8 @@ int PrimalSolver::SolveNewtonStep(const std::vector<IslandBody*>& bodies,
   // kept factor: to the looser stale tolerance, within the refactor budget).
   const bool only_stale = any_stale_ && !coupled_;
   const double tolerance = any_stale_ ? settings.stale_pcg_tolerance : settings.pcg_tolerance;
-  const int max_iterations = only_stale || model_step ? std::max(1, static_cast<int>(stale_budget_))
-                                                      : settings.max_pcg_iterations;
+  const int max_iterations =
+      only_stale ? std::max(1, static_cast<int>(stale_budget_)) : settings.max_pcg_iterations;
   ApplyHessian(bodies, d_, hp_);
   for (size_t b = 0; b < nb; ++b) r_[b] = -grad_[b] - hp_[b];
   const double rhs_norm = std::sqrt(Dot(grad_, grad_));
@@ -561,7 +561,7 @@ double PrimalSolver::StepOnModel(double alpha, const std::vector<IslandBody*>& b
     any_stale_ = true;
     stale_.assign(nb, 1);
     stale_budget_ = settings.model_pcg_iterations;
-    stats.pcg_iterations += SolveNewtonStep(bodies, settings, /*model_step=*/true);
+    stats.pcg_iterations += SolveNewtonStep(bodies, settings);
     if (!(Dot(grad_, d_) < 0.0)) break;
     alpha = SearchModelLine(bodies, Dot(d_, aw_) + Dot(d_, model_gw_));
     if (alpha <= 0.0) break;
@@ -625,7 +625,11 @@ bool PrimalSolver::TakeNewtonStep(double h, const std::vector<IslandBody*>& bodi
   // and the two products of the model line search): no product with A per trial.
   const double phi0 = 0.5 * scale + CalcRowMerit(v_);
   base_.Save(*this);
+  // Islands whose rows couple bodies (rigid contacts, joints) or leave H's pattern take plain
+  // steps: there H is solved by PCG already, and a model step's capped PCG left the rigid box on
+  // a soft block at 2 Newton iterations per step instead of 1 (docs/math.md §5.8, model steps).
   if (primal.max_model_steps > 0 && alpha < primal.model_step_alpha && !model_steps_off_ &&
+      !coupled_ &&
       std::all_of(rows_.rows().begin(), rows_.rows().end(), [](const ConstraintRow& row) {
         return !IsLimitRow(row) || row.exact_curvature;
       })) {

@@ -113,10 +113,7 @@ class PrimalSolver {
   int AssembleNewtonMatrices(const std::vector<IslandBody*>& bodies);
   // d = -H^-1 grad: one solve per body when H = N, else PCG with N as preconditioner. Returns the
   // PCG iterations (1 for the direct solve).
-  // model_step: a model step's solve (docs/math.md §5.8), at most settings.model_pcg_iterations
-  // PCG iterations on coupled islands too.
-  int SolveNewtonStep(const std::vector<IslandBody*>& bodies, const PrimalSettings& settings,
-                      bool model_step = false);
+  int SolveNewtonStep(const std::vector<IslandBody*>& bodies, const PrimalSettings& settings);
   // out = H u (exact operator, matrix-free rows).
   void ApplyHessian(const std::vector<IslandBody*>& bodies, const std::vector<VecX>& u,
                     std::vector<VecX>& out);
