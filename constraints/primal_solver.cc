@@ -526,20 +526,16 @@ void PrimalSolver::CollectRowsAt(double h, const std::vector<IslandBody*>& bodie
 }
 
 double PrimalSolver::CalcModelMerit(const std::vector<IslandBody*>& bodies) {
-  const size_t nb = bodies.size();
-  double energy = 0.0;
-  for (size_t b = 0; b < nb; ++b) {
-    work_[b] = v_[b] - bodies[b]->v_star();
-    bodies[b]->ApplySystemMatrix(work_[b], hp_[b]);
-    energy += 0.5 * work_[b].dot(hp_[b]);
+  const double phi = CalcMerit(bodies, v_);  // the rows' terms are the model's: g0_, J of v_lin
+  for (size_t b = 0; b < bodies.size(); ++b) {
     work_[b] = v_[b] - model_base_[b];
     model_gw_[b].setZero(work_[b].size());
   }
   curvature_.AddTimes(work_, model_gw_);
-  for (size_t b = 0; b < nb; ++b)
+  for (size_t b = 0; b < bodies.size(); ++b)
     for (int i = 0; i < bodies[b]->num_blocks(); ++i)
       if (!bodies[b]->is_free_block(i)) model_gw_[b].segment<3>(3 * i).setZero();
-  return energy + 0.5 * Dot(work_, model_gw_) + CalcRowMerit(v_);
+  return phi + 0.5 * Dot(work_, model_gw_);
 }
 
 double PrimalSolver::StepOnModel(double alpha, const std::vector<IslandBody*>& bodies,
@@ -581,17 +577,11 @@ bool PrimalSolver::TryModelSteps(double h, double alpha, double phi0,
   const double decrease = StepOnModel(alpha, bodies, settings.primal, stats);
   if (!(decrease > 0.0)) return false;
   CollectRowsAt(h, bodies, sources, v_trial_, settings, stats);
-  double energy = 0.0;
-  for (size_t b = 0; b < bodies.size(); ++b) {
-    work_[b] = v_trial_[b] - bodies[b]->v_star();
-    bodies[b]->ApplySystemMatrix(work_[b], hp_[b]);
-    energy += 0.5 * work_[b].dot(hp_[b]);
-  }
   // Sufficient decrease against the model's decrease (the plain step: alpha times the decrement).
   // Phi fell by less than half the model's prediction: the linearization is poor here (rows that
   // flip, kinks of the principal stretches), and model steps wander on it; the rest of the step
   // takes plain Newton steps.
-  const double phi = energy + CalcRowMerit(v_trial_);
+  const double phi = CalcMerit(bodies, v_trial_);
   if (phi0 - phi < 0.5 * decrease) model_steps_off_ = true;
   if (phi <= phi0 - 1e-4 * decrease) return true;
   base_.Restore(*this);

@@ -80,8 +80,6 @@ class PrimalSolver {
   // Stage: G = h sum lambda_c [-d^2 C_c]_+ as node blocks, from the sources of limit rows.
   void CollectCurvature(double h, const std::vector<IslandBody*>& bodies,
                         const std::vector<ConstraintSource*>& sources);
-  // Stage: one Newton step on Phi from v_ (rows collected at v_); returns false when v_ is
-  // stationary (Newton decrement below tolerance) and nothing moved.
   // Newton steps on the model of the rows linearized at v (docs/math.md §5.8, model steps), from
   // v + alpha d while the model line search stops below settings.model_step_alpha. The end point
   // is left in v_trial_ (v_ is restored); returns the decrease of the model's Phi.
@@ -95,6 +93,8 @@ class PrimalSolver {
   bool TryModelSteps(double h, double alpha, double phi0, const std::vector<IslandBody*>& bodies,
                      const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
                      StepStats& stats);
+  // Stage: one Newton step on Phi from v_ (rows collected at v_); returns false when v_ is
+  // stationary (Newton decrement below tolerance) and nothing moved.
   bool TakeNewtonStep(double h, const std::vector<IslandBody*>& bodies,
                       const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
                       StepStats& stats);

@@ -148,6 +148,12 @@ bool HasStrainFrameCurvature(const StrainLimitParams& params) {
          !(IsUniform(params.kappa_max) && IsUniform(params.kappa_min));
 }
 
+bool HasExactStrainCurvature(const StrainLimitParams& params) {
+  return HasStrainFrameCurvature(params) ||
+         (params.projection == StrainProjection::kEllipsoid && IsUniform(params.kappa_max) &&
+          IsUniform(params.kappa_min));
+}
+
 Mat9 CalcPrincipalStrainRowCurvature(const SignedSvd& svd, const Mat3& Q,
                                      const StrainLimitParams& params, const StrainLimitKey& key) {
   TAUT_ASSERT(params.projection == StrainProjection::kHyperbolic ||

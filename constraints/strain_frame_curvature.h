@@ -27,6 +27,11 @@ namespace taut {
 // principal frame through a(v_i) (hyperbolic, or ellipsoid with unequal weights).
 bool HasStrainFrameCurvature(const StrainLimitParams& params);
 
+// True when the rows' curvature term is their whole second derivative: the frame factor's term is
+// in (HasStrainFrameCurvature), or the rows do not depend on the frame (ellipsoid rows of equal
+// weights on every axis, C a function of one stretch s_i). The primal path's model steps trust it.
+bool HasExactStrainCurvature(const StrainLimitParams& params);
+
 // -d^2 C/dP^2 of the row `key` (hyperbolic or ellipsoid) as a symmetric 9x9 matrix over vec(P),
 // P = U^T dF V (row-major index 3 x + y for P_xy), not clamped; Q is the element's limit frame.
 // Zero when the frame factor vanishes (a hyperbolic row at its |V'_ji| kink never binds).

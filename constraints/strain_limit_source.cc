@@ -24,12 +24,7 @@ StrainLimitSource::StrainLimitSource(const DeformableBody& body,
   settings_.Validate(tets_.num_elements(), "body '" + body.name() + "' strain limits");
   params_ = CalcStrainLimitParams(settings_);
   full_curvature_ = HasStrainFrameCurvature(params_);
-  // The curvature term is the rows' whole second derivative: with the frame factor's term, or
-  // ellipsoid rows of equal limits on every axis (C a function of one stretch s_i, no frame).
-  exact_curvature_ =
-      full_curvature_ || (params_.projection == StrainProjection::kEllipsoid &&
-                          params_.kappa_max.minCoeff() == params_.kappa_max.maxCoeff() &&
-                          params_.kappa_min.minCoeff() == params_.kappa_min.maxCoeff());
+  exact_curvature_ = HasExactStrainCurvature(params_);
   // Hyperbolic and ellipsoid rows bound their C by the stretches alone (CalcStretchBand): rows
   // are emitted below C = tau (the activation band), a violation needs C < 0 (tau = 0).
   const double tau = params_.activation_margin;

@@ -67,7 +67,7 @@ class StrainLimitSource final : public BodyConstraintSource {
   RowKeyPacker<4> key_;                       // kStrainLimitRowKey with this source's id
   std::vector<StrainLimitRow> element_rows_;  // scratch, reused
   bool full_curvature_ = false;   // HasStrainFrameCurvature(params_): rows' full_curvature
-  bool exact_curvature_ = false;  // rows' exact_curvature
+  bool exact_curvature_ = false;  // HasExactStrainCurvature(params_): rows' exact_curvature
   bool screen_ = false;           // IsSurelyInside applies (hyperbolic and ellipsoid modes)
   StretchBand active_band_;       // no row: C > activation margin
   StretchBand violation_band_;    // no violation: C > 0

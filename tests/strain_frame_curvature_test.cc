@@ -179,6 +179,12 @@ TEST(StrainFrameCurvatureIsotropicTest, ReducesToTheStretchCurvature) {
   params.kappa_max = Vec3::Constant(4.0);
   params.kappa_min = Vec3::Constant(2.0);
   EXPECT_FALSE(HasStrainFrameCurvature(params));
+  // ... so the stretch curvature alone is exact (the primal path's model steps rely on it); the
+  // orthogonal projection's rows depend on the frame without a frame term.
+  EXPECT_TRUE(HasExactStrainCurvature(params));
+  StrainLimitParams orthogonal = params;
+  orthogonal.projection = StrainProjection::kOrthogonal;
+  EXPECT_FALSE(HasExactStrainCurvature(orthogonal));
   std::mt19937 rng(5);
   double worst = 0.0;
   for (int trial = 0; trial < 100; ++trial) {
