@@ -95,6 +95,14 @@ bool SqpSolver::AcceptFullStep(double h, const std::vector<IslandBody*>& bodies,
   // the step need not lower the energy term; curved rows add second-order violation), and merit
   // steps of 1/2 converge only linearly. The certificate is the measure of progress here.
   const KktResiduals full = CalcFullStepCertificate(h, bodies, sources, settings, stats);
+  // A full step certified with its distance rows tight is the iterate the SQP stops at next. From
+  // a warm start already at the answer the QP step is ~0: the merit's sufficient decrease fails
+  // on round-off and its residual cannot fall by 10 % (the finger's held presses: five halvings
+  // to alpha = 1/32, half of their step time).
+  if (IsCertified(full, settings.violation_tolerance, settings.stationarity_tolerance) &&
+      full.max_distance_residual() <=
+          settings.warm_stop_distance_factor * settings.violation_tolerance)
+    return true;
   const double bound =
       std::max(violation, settings.full_step_violation_factor * settings.violation_tolerance);
   return CalcCertificateResidual(full, settings.violation_tolerance,

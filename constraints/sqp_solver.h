@@ -106,8 +106,10 @@ class SqpSolver {
                                        const std::vector<ConstraintSource*>& sources,
                                        const SqpSettings& settings, StepStats& stats);
   // True when the full QP step may be taken although the merit rejects it
-  // (SqpSettings::certificate_steps): its certificate's residual is below 0.9 x `residual` and
-  // its worst violation below max(`violation`, full_step_violation_factor x tolerance).
+  // (SqpSettings::certificate_steps): it is certified with its distance rows within
+  // warm_stop_distance_factor of their tolerance, or its certificate's residual is below
+  // 0.9 x `residual` and its worst violation below max(`violation`, full_step_violation_factor x
+  // tolerance).
   bool AcceptFullStep(double h, const std::vector<IslandBody*>& bodies,
                       const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
                       double residual, double violation, StepStats& stats);
