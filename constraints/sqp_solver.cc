@@ -128,8 +128,10 @@ void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
   warm_started_ = settings.warm_start && settings.warm_start_velocity &&
                   StartFromWarmMultipliers(h, bodies, sources, settings, stats);
   Iterate(h, bodies, sources, settings, stats);
-  if (warm_started_ && !stats.converged) {
-    // Not certified from the warm-start velocity: the papers' start v* (docs/math.md §5.7).
+  if (warm_started_ && !stats.converged && !stalled_infeasible_) {
+    // Not certified from the warm-start velocity: the papers' start v* (docs/math.md §5.7). Not
+    // after a stall where no push lowers the violation: measured, the start from v* stalled at
+    // the same violation in every such step (the finger's 2 locked advances, 42 stress steps).
     const int iterations = stats.sqp_iterations;
     BeginSolve(bodies, settings);
     warm_started_ = false;
