@@ -411,6 +411,29 @@ TEST(PrimalSolverTest, InfeasibleDualStepStopsWhereNothingLowersItsViolation) {
   EXPECT_LT(stats.violation_after, stats.violation_before);
 }
 
+// A warm-started dual step that stalls locally infeasible is not started over from v*: from there
+// the SQP stalled at the same violation in every such step measured (docs/math.md §5.7). One
+// solve: its SQP cap, then push-only restoration until nothing lowers the violation (started
+// over, the bar's step ran 16 iterations, 4 of them restoration, and ended at violation 104
+// instead of 80).
+TEST(PrimalSolverTest, WarmStartedDualStepThatStallsInfeasibleIsNotStartedOver) {
+  OverstretchedBar bar;
+  SqpSettings& settings = bar.holder.world.mutable_solver_settings();
+  settings.solver = IslandSolverKind::kDual;
+  bar.Step();
+  const StepStats& stats = bar.Step();
+  std::printf(
+      "warm-started infeasible dual step: %d SQP iterations (cap %d), %d of them "
+      "restoration; violation %.3g -> %.3g\n",
+      stats.sqp_iterations, settings.max_iterations, stats.restoration_iterations,
+      stats.violation_before, stats.violation_after);
+  ASSERT_FALSE(stats.converged);
+  EXPECT_EQ(stats.islands_dual, 1);
+  EXPECT_GT(stats.restoration_iterations, 0);
+  EXPECT_EQ(stats.sqp_iterations, settings.max_iterations + stats.restoration_iterations);
+  EXPECT_LT(stats.violation_after, stats.violation_before);
+}
+
 // The second step takes the primal path (the dual failed on this limit-only island), which fails;
 // its retry on the dual path stops at SqpSettings::retry_max_iterations.
 TEST(PrimalSolverTest, RetryOfAnInfeasibleStepStopsAtItsCap) {
