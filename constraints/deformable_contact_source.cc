@@ -80,34 +80,6 @@ DeformableContactSource::DeformableContactSource(const DeformableBody& body,
   self_ = std::make_unique<SelfContactSearch>(body, surface, margin);
 }
 
-bool DeformableContactSource::FindNearestTriangle(const ContactSurface& surface, const VecX& x,
-                                                  const Vec3& p, Hit& hit) const {
-  double best = margin_;
-  bool found = false;
-  for (size_t t = 0; t < surface.triangles.size(); ++t) {
-    const Vec3 v0 = x.segment<3>(3 * CornerNode(surface, static_cast<int>(t), 0));
-    const Vec3 v1 = x.segment<3>(3 * CornerNode(surface, static_cast<int>(t), 1));
-    const Vec3 v2 = x.segment<3>(3 * CornerNode(surface, static_cast<int>(t), 2));
-    // Cheap rejection by the triangle's bounds grown by the margin.
-    const Vec3 lo = v0.cwiseMin(v1).cwiseMin(v2).array() - margin_;
-    const Vec3 hi = v0.cwiseMax(v1).cwiseMax(v2).array() + margin_;
-    if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) continue;
-    const Vec3 beta = internal::CalcNearestTrianglePoint(p, v0, v1, v2);
-    const Vec3 q = beta[0] * v0 + beta[1] * v1 + beta[2] * v2;
-    const double distance = (p - q).norm();
-    if (distance >= best) continue;
-    const Vec3 normal = (v1 - v0).cross(v2 - v0);
-    if (normal.squaredNorm() == 0.0) continue;  // degenerate triangle
-    best = distance;
-    found = true;
-    hit.triangle = static_cast<int>(t);
-    hit.beta = beta;
-    hit.normal = normal.normalized();
-    hit.gap = hit.normal.dot(p - q);
-  }
-  return found;
-}
-
 void DeformableContactSource::FindHits(const VecX& xa, const VecX& xb) const {
   if (self_ == nullptr) {
     FindPairHits(xa, xb);
@@ -125,26 +97,42 @@ void DeformableContactSource::FindPairHits(const VecX& xa, const VecX& xb) const
   for (int direction = 0; direction < 2; ++direction) {
     const ContactSurface& points = surfaces_[direction];
     const ContactSurface& target = surfaces_[1 - direction];
-    if (!target.node_triangles || target.triangles.empty()) continue;
-    const VecX& xp = *x[direction];
+    if (!target.node_triangles || target.triangles.empty() || points.points.empty()) continue;
     const VecX& xt = *x[1 - direction];
-    // Bounds of the target's nodes, grown by the margin: points outside skip the search.
-    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-    for (const ContactPoint& corner : target.points) {
-      lo = lo.cwiseMin(Vec3(xt.segment<3>(3 * corner.nodes[0])));
-      hi = hi.cwiseMax(Vec3(xt.segment<3>(3 * corner.nodes[0])));
+    const auto corner = [&](std::size_t t, int k) -> Vec3 {
+      return xt.segment<3>(3 * CornerNode(target, static_cast<int>(t), k));
+    };
+    point_positions_.resize(points.points.size());
+    for (size_t i = 0; i < points.points.size(); ++i)
+      point_positions_[i] = CalcContactPointPosition(points.points[i], *x[direction]);
+    hash_.Build(point_positions_, CalcHashCellSize(target.triangles, margin_, corner));
+    // Per point the nearest triangle within the margin, triangles in order (the first of equal
+    // distances).
+    best_.assign(points.points.size(), Hit{direction, -1, -1, Vec3::Zero(), Vec3::Zero(), 0.0});
+    best_distance_.assign(points.points.size(), margin_);
+    for (size_t t = 0; t < target.triangles.size(); ++t) {
+      const Vec3 v0 = corner(t, 0), v1 = corner(t, 1), v2 = corner(t, 2);
+      const Vec3 lo = v0.cwiseMin(v1).cwiseMin(v2).array() - margin_;
+      const Vec3 hi = v0.cwiseMax(v1).cwiseMax(v2).array() + margin_;
+      hash_.ForEachPointInBox(lo, hi, [&](int i) {
+        const Vec3& p = point_positions_[i];
+        const Vec3 beta = internal::CalcNearestTrianglePoint(p, v0, v1, v2);
+        const Vec3 q = beta[0] * v0 + beta[1] * v1 + beta[2] * v2;
+        const double distance = (p - q).norm();
+        if (distance >= best_distance_[i]) return;
+        const Vec3 normal = (v1 - v0).cross(v2 - v0);
+        if (normal.squaredNorm() == 0.0) return;  // degenerate triangle
+        best_distance_[i] = distance;
+        Hit& hit = best_[i];
+        hit.point = i;
+        hit.triangle = static_cast<int>(t);
+        hit.beta = beta;
+        hit.normal = normal.normalized();
+        hit.gap = hit.normal.dot(p - q);
+      });
     }
-    lo.array() -= margin_;
-    hi.array() += margin_;
-    for (size_t i = 0; i < points.points.size(); ++i) {
-      const Vec3 p = CalcContactPointPosition(points.points[i], xp);
-      if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) continue;
-      Hit hit;
-      if (!FindNearestTriangle(target, xt, p, hit)) continue;
-      hit.direction = direction;
-      hit.point = static_cast<int>(i);
-      hits_.push_back(hit);
-    }
+    for (const Hit& hit : best_)
+      if (hit.triangle >= 0) hits_.push_back(hit);
   }
 }
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "constraints/constraint_row.h"
+#include "constraints/point_spatial_hash.h"
 #include "constraints/row_key_layouts.h"
 #include "constraints/self_contact_search.h"
 #include "plugin/contact_surface.h"
@@ -53,11 +54,9 @@ class DeformableContactSource final : public ConstraintSource {
   };
   // Every point-triangle contact within the margin at positions xa, xb (self-contact: xa).
   void FindHits(const VecX& xa, const VecX& xb) const;
-  // The pair's contacts: both directions, every triangle of the other body tested.
+  // The pair's contacts, both directions: per point of one body the nearest triangle of the other
+  // within the margin, the candidates from a spatial hash of the points.
   void FindPairHits(const VecX& xa, const VecX& xb) const;
-  // Nearest triangle of `surface` (positions x) to p within the margin; false when none.
-  bool FindNearestTriangle(const ContactSurface& surface, const VecX& x, const Vec3& p,
-                           Hit& hit) const;
 
   const DeformableBody& a_;
   const DeformableBody& b_;
@@ -67,6 +66,11 @@ class DeformableContactSource final : public ConstraintSource {
   std::unique_ptr<SelfContactSearch> self_;  // self-contact only
   mutable std::vector<Hit> hits_;            // scratch of the last FindHits
   mutable std::vector<SelfContactSearch::Hit> self_hits_;
+  // Scratch of FindPairHits: the points' positions and their hash, the nearest hit per point.
+  mutable std::vector<Vec3> point_positions_;
+  mutable PointSpatialHash hash_;
+  mutable std::vector<Hit> best_;
+  mutable std::vector<double> best_distance_;
 };
 
 namespace internal {

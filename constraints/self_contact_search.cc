@@ -9,13 +9,6 @@
 
 namespace taut {
 
-namespace {
-// Cell coordinate of a position coordinate (clamped far inside int64 for wild iterates).
-std::int64_t CellOf(double coordinate, double cell) {
-  return static_cast<std::int64_t>(std::clamp(std::floor(coordinate / cell), -1e15, 1e15));
-}
-}  // namespace
-
 SelfContactSearch::SelfContactSearch(const DeformableBody& body, const ContactSurface& surface,
                                      double margin)
     : body_(body), triangles_(surface.triangles), margin_(margin) {
@@ -37,76 +30,25 @@ SelfContactSearch::SelfContactSearch(const DeformableBody& body, const ContactSu
   FindExcludedPairs(body.model().rest_positions());
 }
 
-std::size_t SelfContactSearch::BucketOf(std::int64_t ix, std::int64_t iy, std::int64_t iz) const {
-  // Teschner et al. 2003: (x p1 xor y p2 xor z p3) mod table size, here a power of two.
-  const auto mix = (static_cast<std::uint64_t>(ix) * 73856093u) ^
-                   (static_cast<std::uint64_t>(iy) * 19349663u) ^
-                   (static_cast<std::uint64_t>(iz) * 83492791u);
-  return static_cast<std::size_t>(mix & (bucket_start_.size() - 2));
-}
-
 void SelfContactSearch::CalcPointPositions(const VecX& x) const {
   positions_.resize(node_of_point_.size());
   for (size_t i = 0; i < node_of_point_.size(); ++i)
     positions_[i] = x.segment<3>(3 * node_of_point_[i]);
 }
 
-void SelfContactSearch::BuildHash(double cell) const {
-  cell_ = cell;
-  const size_t num_points = positions_.size();
-  size_t buckets = 1;
-  while (buckets < 2 * num_points) buckets <<= 1;
-  bucket_start_.assign(buckets + 1, 0);  // BucketOf reads the table size from here
-  auto bucket_of = [&](const Vec3& p) {
-    return BucketOf(CellOf(p.x(), cell), CellOf(p.y(), cell), CellOf(p.z(), cell));
-  };
-  for (const Vec3& p : positions_) ++bucket_start_[bucket_of(p) + 1];
-  for (size_t b = 0; b < buckets; ++b) bucket_start_[b + 1] += bucket_start_[b];
-  bucket_fill_.assign(bucket_start_.begin(), bucket_start_.end() - 1);
-  bucket_points_.resize(num_points);
-  for (size_t i = 0; i < num_points; ++i)
-    bucket_points_[bucket_fill_[bucket_of(positions_[i])]++] = static_cast<int>(i);
-}
-
 template <typename Visit>
 void SelfContactSearch::ForEachNearPair(const VecX& x, double reach, Visit&& visit) const {
   CalcPointPositions(x);
   if (triangles_.empty() || positions_.empty()) return;
-  // Cells about as large as a triangle's bounds: each triangle covers a few cells.
-  double extent = 0.0;
-  for (const Triangle& t : triangles_) {
-    const Vec3 &v0 = positions_[t[0]], &v1 = positions_[t[1]], &v2 = positions_[t[2]];
-    extent += (v0.cwiseMax(v1).cwiseMax(v2) - v0.cwiseMin(v1).cwiseMin(v2)).maxCoeff();
-  }
-  BuildHash(std::max(reach, extent / static_cast<double>(triangles_.size())));
-  const size_t buckets = bucket_start_.size() - 1;
+  hash_.Build(positions_, CalcHashCellSize(triangles_, reach, [&](std::size_t t, int k) {
+                return positions_[triangles_[t][k]];
+              }));
   for (size_t t = 0; t < triangles_.size(); ++t) {
     const Triangle& tri = triangles_[t];
     const Vec3 &v0 = positions_[tri[0]], &v1 = positions_[tri[1]], &v2 = positions_[tri[2]];
     const Vec3 lo = v0.cwiseMin(v1).cwiseMin(v2).array() - reach;
     const Vec3 hi = v0.cwiseMax(v1).cwiseMax(v2).array() + reach;
-    auto visit_bucket = [&](size_t b) {
-      for (int k = bucket_start_[b]; k < bucket_start_[b + 1]; ++k) {
-        const int i = bucket_points_[k];
-        const Vec3& p = positions_[i];
-        if ((p.array() < lo.array()).any() || (p.array() > hi.array()).any()) continue;
-        visit(i, static_cast<int>(t), v0, v1, v2);
-      }
-    };
-    std::int64_t first[3], last[3];
-    double cells = 1.0;
-    for (int a = 0; a < 3; ++a) {
-      first[a] = CellOf(lo[a], cell_);
-      last[a] = CellOf(hi[a], cell_);
-      cells *= static_cast<double>(last[a] - first[a] + 1);
-    }
-    if (cells > static_cast<double>(buckets)) {
-      for (size_t b = 0; b < buckets; ++b) visit_bucket(b);  // a huge triangle: every bucket once
-      continue;
-    }
-    for (std::int64_t ix = first[0]; ix <= last[0]; ++ix)
-      for (std::int64_t iy = first[1]; iy <= last[1]; ++iy)
-        for (std::int64_t iz = first[2]; iz <= last[2]; ++iz) visit_bucket(BucketOf(ix, iy, iz));
+    hash_.ForEachPointInBox(lo, hi, [&](int i) { visit(i, static_cast<int>(t), v0, v1, v2); });
   }
 }
 

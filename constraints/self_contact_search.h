@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "constraints/point_spatial_hash.h"
 #include "plugin/contact_surface.h"
 #include "plugin/deformable_body.h"
 
@@ -22,11 +23,8 @@ namespace taut {
 //    contacts;
 //  - moving: a node of the point or of the triangle is free;
 //  - within the margin: |p_i - q| < margin (q the nearest point of t).
-// Broadphase: a uniform spatial hash of the points (Teschner et al. 2003, "Optimized spatial
-// hashing for collision detection of deformable objects": cells hashed into a table of at least
-// 2 P buckets), rebuilt per call; each triangle visits the cells of its bounds grown by the
-// margin. Cell size: the mean extent of the triangles' bounds, at least the margin. O(P + T)
-// per call for a well-shaped surface; buffers are reused (no allocation once sized).
+// Broadphase: the points in a spatial hash (constraints/point_spatial_hash.h), rebuilt per call;
+// each triangle visits the points in its bounds grown by the margin.
 class SelfContactSearch {
  public:
   // Rest exclusion radius in contact margins.
@@ -55,15 +53,10 @@ class SelfContactSearch {
  private:
   // Positions of the points at node positions x (positions_).
   void CalcPointPositions(const VecX& x) const;
-  // Points sorted into the buckets of a hash with cells of size `cell` [m] (bucket_start_,
-  // bucket_points_).
-  void BuildHash(double cell) const;
   // Calls visit(i, t, v0, v1, v2) for every point i inside triangle t's bounds grown by `reach`
   // (triangles in order; a point may be visited twice for one triangle).
   template <typename Visit>
   void ForEachNearPair(const VecX& x, double reach, Visit&& visit) const;
-  // Bucket of cell (ix, iy, iz).
-  std::size_t BucketOf(std::int64_t ix, std::int64_t iy, std::int64_t iz) const;
   // The rest-exclusion pairs, sorted by point (excluded_start_, excluded_).
   void FindExcludedPairs(const VecX& rest);
   // Area-weighted normals of the points at positions x (point_normals_).
@@ -79,10 +72,9 @@ class SelfContactSearch {
   std::vector<int> excluded_;        // excluded triangles of each point, ascending
   // Scratch of the last call.
   mutable std::vector<Vec3> positions_, point_normals_;
-  mutable std::vector<int> bucket_start_, bucket_points_, bucket_fill_;
+  mutable PointSpatialHash hash_;  // of positions_
   mutable std::vector<Hit> best_;  // nearest admissible triangle per point (triangle -1: none)
   mutable std::vector<double> best_distance_;  // its distance [m] (the margin when none)
-  mutable double cell_ = 1.0;
 };
 
 }  // namespace taut
