@@ -8,8 +8,6 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <type_traits>
 
@@ -293,14 +291,6 @@ void DeformableWorldOf<BulletWorld>::internalSingleStepSimulation(btScalar h) {
                     stats_.ms_stage_islands - stats_.ms_stage_couple_rigid -
                     stats_.ms_stage_row_sources - stats_.ms_stage_solve_islands -
                     stats_.ms_integrate;
-  if (getenv("TAUT_DBG") && stats_.ms_total > 3)
-    fprintf(stderr,
-            "STAGEDBG total=%.3f unc=%.3f partners=%.3f islands=%.3f couple=%.3f sources=%.3f "
-            "bullet=%.3f solve_islands=%.3f integ=%.3f rigid=%.3f\n",
-            stats_.ms_total, stats_.ms_unconstrained, stats_.ms_stage_partners,
-            stats_.ms_stage_islands, stats_.ms_stage_couple_rigid, stats_.ms_stage_row_sources,
-            stats_.ms_stage_bullet_solver, stats_.ms_stage_solve_islands, stats_.ms_integrate,
-            stats_.ms_rigid);
   AddSubstepStats(stats_, call_stats_);
 }
 

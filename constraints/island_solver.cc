@@ -1,8 +1,6 @@
 #include "constraints/island_solver.h"
 
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <utility>
 
 namespace taut {
@@ -83,15 +81,6 @@ void IslandSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     }
   }
   state_.last_rows = stats.rows_total();
-  if (getenv("TAUT_DBG"))
-    fprintf(stderr,
-            "DBG kind=%d retry=%d sqp=%d newton=%d retried=%d conv=%d viol=%g primal_left=%d "
-            "dual_left=%d noretry=%d kp=%g %g %g %g %g %g\n",
-            (int)kind, (int)retry, stats.sqp_iterations, stats.newton_iterations,
-            stats.islands_retried, (int)stats.converged, stats.violation_after, state_.primal.left,
-            state_.dual.left, state_.no_retry.left, stats.kkt_primal_by_type[0],
-            stats.kkt_primal_by_type[1], stats.kkt_primal_by_type[2], stats.kkt_primal_by_type[3],
-            stats.kkt_primal_by_type[4], stats.kkt_primal_by_type[5]);
 }
 
 void IslandSolver::SolveOn(IslandSolverKind kind, double h, const std::vector<IslandBody*>& bodies,

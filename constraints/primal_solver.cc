@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 
 namespace taut {
@@ -597,9 +595,7 @@ bool PrimalSolver::TakeNewtonStep(double h, const std::vector<IslandBody*>& bodi
   const size_t nb = bodies.size();
   CalcProjectedMultipliers();
   CalcGradient(bodies);
-  static const int exp3 = getenv("TAUT_EXP3") ? atoi(getenv("TAUT_EXP3")) : 0;
-  if (primal.curvature && exp3 && newton_in_iter_ > 0) {
-  } else if (primal.curvature)
+  if (primal.curvature)
     CollectCurvature(h, bodies, sources);
   else
     curvature_.Clear();
@@ -611,12 +607,8 @@ bool PrimalSolver::TakeNewtonStep(double h, const std::vector<IslandBody*>& bodi
   // Newton decrement -grad^T d against the scale ||v - v*||_A^2 (A(v - v*) from the gradient).
   const double decrement = -Dot(grad_, d_);
   const double scale = Dot(w_, aw_);
-  last_rel_dec_ = decrement / std::max(scale, 1e-300);
   if (!(decrement > primal.newton_tolerance * std::max(scale, 1e-300))) return false;
   double alpha = SearchModelLine(bodies, Dot(d_, aw_));
-  if (getenv("TAUT_DBG"))
-    fprintf(stderr, "  LS alpha=%g dec=%g scale=%g rows=%d\n", alpha, decrement, scale,
-            rows_.size());
   if (alpha <= 0.0) return false;
   // Armijo backtracking on the nonlinear Phi (rows re-evaluated at each trial). With w = v - v*
   // the energy at v + alpha d is 1/2 w^T A w + alpha d^T A w + alpha^2/2 d^T A d (scale = w^T A w
@@ -672,9 +664,6 @@ bool PrimalSolver::IsNewtonIterateCertified(const std::vector<IslandBody*>& bodi
     return false;
   const double distance_tolerance =
       settings.primal.newton_stop_distance_factor * settings.violation_tolerance;
-  if (getenv("TAUT_EXP2") &&
-      kkt.max_complementarity() > atof(getenv("TAUT_EXP2")) * settings.violation_tolerance)
-    return false;
   return kkt.max_distance_residual() <= distance_tolerance;
 }
 
@@ -771,9 +760,6 @@ void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     RecordKkt(kkt, stats);
     stats.converged =
         IsCertified(kkt, settings.violation_tolerance, settings.stationarity_tolerance);
-    if (stats.converged && getenv("TAUT_EXP") && k <= 1 &&
-        kkt.max_complementarity() > 0.5 * settings.violation_tolerance)
-      stats.converged = false;
     if (stats.converged || k >= primal.max_iterations) {
       stats.ms_solve += MsSince(t);
       break;
@@ -783,20 +769,10 @@ void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     if (primal.penalty_growth > 1.0) GrowStalledPenalties(primal, settings.violation_tolerance);
     KeepPenalties();
     for (int it = 0; it < primal.max_newton_iterations; ++it) {
-      newton_in_iter_ = it;
       if (!TakeNewtonStep(h, bodies, sources, settings, stats)) break;
       newton_certified_ =
           primal.stop_newton_on_certificate && IsNewtonIterateCertified(bodies, h, settings);
-      if (getenv("TAUT_DBG"))
-        fprintf(stderr, "  NT it=%d viol=%g cert=%d kp=%g kc=%g kd=%g ks=%g dist=%g cp=%g %g %g\n",
-                it, violation_, (int)newton_certified_, newton_kkt_.max_primal(),
-                newton_kkt_.max_complementarity(), newton_kkt_.dual, newton_kkt_.stationarity,
-                newton_kkt_.max_distance_residual(), newton_kkt_.complementarity[0],
-                newton_kkt_.complementarity[2], newton_kkt_.complementarity[3]);
       if (newton_certified_) break;
-      static const double exp4 = getenv("TAUT_EXP4") ? atof(getenv("TAUT_EXP4")) : 0;
-      if (exp4 > 0 && it >= 1 && violation_ <= settings.violation_tolerance && last_rel_dec_ < exp4)
-        break;
     }
     if (!newton_certified_) CalcProjectedMultipliers();  // else lambda_ is Proj(y(v)) already
     lambda_bar_ = lambda_;
