@@ -87,6 +87,11 @@ KktResiduals SqpSolver::CalcFullStepCertificate(double h, const std::vector<Isla
   return CalcKktResiduals(bodies, full_rows_, full_lambda_, v_qp_, h, distance_scale, scratch_);
 }
 
+bool SqpSolver::HasTightDistanceRows(const KktResiduals& kkt, const SqpSettings& settings) {
+  return kkt.max_distance_residual() <=
+         settings.warm_stop_distance_factor * settings.violation_tolerance;
+}
+
 bool SqpSolver::AcceptFullStep(double h, const std::vector<IslandBody*>& bodies,
                                const std::vector<ConstraintSource*>& sources,
                                const SqpSettings& settings, double residual, double violation,
@@ -100,8 +105,7 @@ bool SqpSolver::AcceptFullStep(double h, const std::vector<IslandBody*>& bodies,
   // on round-off and its residual cannot fall by 10 % (the finger's held presses: five halvings
   // to alpha = 1/32, half of their step time).
   if (IsCertified(full, settings.violation_tolerance, settings.stationarity_tolerance) &&
-      full.max_distance_residual() <=
-          settings.warm_stop_distance_factor * settings.violation_tolerance)
+      HasTightDistanceRows(full, settings))
     return true;
   const double bound =
       std::max(violation, settings.full_step_violation_factor * settings.violation_tolerance);
@@ -180,9 +184,7 @@ void SqpSolver::Iterate(double h, const std::vector<IslandBody*>& bodies,
     // pushed in by less than its tolerance kept its old impulse), and distance rows within
     // warm_stop_distance_factor of their tolerance (certified at the tolerance's edge step after
     // step, a pressed contact sinks to the full tolerance; docs/math.md §5.7).
-    const bool tight = !warm_started_ ||
-                       (k > 0 && kkt.max_distance_residual() <= settings.warm_stop_distance_factor *
-                                                                    settings.violation_tolerance);
+    const bool tight = !warm_started_ || (k > 0 && HasTightDistanceRows(kkt, settings));
     const bool done =
         tight && (settings.certificate_steps ? stats.converged
                                              : stationarity <= settings.stationarity_tolerance);

@@ -105,6 +105,8 @@ class SqpSolver {
   KktResiduals CalcFullStepCertificate(double h, const std::vector<IslandBody*>& bodies,
                                        const std::vector<ConstraintSource*>& sources,
                                        const SqpSettings& settings, StepStats& stats);
+  // Distance rows (contacts, joints) of `kkt` within warm_stop_distance_factor of their tolerance.
+  static bool HasTightDistanceRows(const KktResiduals& kkt, const SqpSettings& settings);
   // True when the full QP step may be taken although the merit rejects it
   // (SqpSettings::certificate_steps): it is certified with its distance rows within
   // warm_stop_distance_factor of their tolerance, or its certificate's residual is below
