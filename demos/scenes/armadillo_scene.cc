@@ -16,6 +16,10 @@ namespace {
 constexpr double kHeight = 2.0;       // [m], the scan's y axis is up
 constexpr double kCellSize = 0.1145;  // [m] -> 368 hexes (paper: ~365)
 constexpr double kDrop = 0.5;         // lowest point above the ground at t = 0 [m]
+// Distance between the bodies along x [m]: the scan is 1.68 m wide, and at 2 m apart the
+// flattened bodies touched from t = 0.69 s on (one island of three bodies); the paper drops each
+// armadillo alone.
+constexpr double kSpacing = 3.5;
 
 // Vertical extent of a body's nodes.
 void CalcZRange(const DeformableBody& body, double& lo, double& hi) {
@@ -52,7 +56,7 @@ ArmadilloScene::ArmadilloScene(const std::vector<Material>& materials,
   holder_.AddStaticGround();
   for (size_t m = 0; m < materials.size(); ++m) {
     SurfaceMesh placed = scan;
-    for (Vec3& v : placed.vertices) v.x() += 2.0 * static_cast<double>(m);
+    for (Vec3& v : placed.vertices) v.x() += kSpacing * static_cast<double>(m);
     placed.source = materials[m].name;
     auto lattice = std::make_shared<HexLattice>(VoxelizeSurface(placed, kCellSize));
     DeformableBodySettings settings =
