@@ -3,7 +3,9 @@
 #   OUT_DIR/results.json   Google Benchmark's JSON (every aggregate and counter)
 #   OUT_DIR/summary.md     tables: taut vs Bullet's deformable world, tet-beam scaling with the
 #                          fitted growth exponent, point-vs-shape narrowphase time and accuracy,
-#                          island solvers (dual / primal / auto) against the unconstrained step
+#                          island solvers (dual / primal / auto) against the unconstrained step,
+#                          real-time figures (finger steps, armadillo ms per body per frame on 1
+#                          and 2 threads, bench/real_time_bench.cc)
 # Usage: scripts/run_bench.sh [OUT_DIR] [--merge] [-- extra taut_bench flags, e.g.
 #   --benchmark_filter=...]   (default OUT_DIR docs/bench; build dir build/bench, or
 #   TAUT_BENCH_BUILD_DIR). The full run takes ~30 min on 2 cores, most of it in the 51k and 103k
@@ -281,9 +283,48 @@ if island:
                 out.append(f"| {base} | {sizes} | {path} | {fit([(x, y) for x, y, _ in pts]):.2f} | "
                            f"{fit([(x, u) for x, _, u in pts]):.2f} | {p_twin:.2f} |")
 
+finger = rows("BM_RealTimeFinger")
+armadillo = sorted(rows("BM_RealTimeArmadillo/"),
+                   key=lambda nb: (-nb[1]["real_time"], nb[0]))
+if finger or armadillo:
+    cpu = next((b.get("run_cpu_model") for _, b in finger + armadillo if b.get("run_cpu_model")),
+               "unknown CPU")
+    out += ["", "## Real-time targets (issue 12)", "",
+            f"bench/real_time_bench.cc on the demo scenes themselves, {cpu}, "
+            f"{next((b.get('run_date') for _, b in finger + armadillo), '')}; medians of 3 "
+            "repetitions. Only the scenes' `Simulate` is timed (their measurements run outside).",
+            ""]
+for _, b in finger:
+    out += ["Finger (`taut-demo finger`: 520 steps of h = 1 ms, every press; target: every step "
+            "<= 1 ms), thread CPU time per step:", "",
+            "| median ms | p99 ms | max ms | steps over 1 ms | unconverged |",
+            "|---:|---:|---:|---:|---:|",
+            f"| {fmt(b['step_median_ms'])} | {fmt(b['step_p99_ms'])} | {fmt(b['step_max_ms'])} | "
+            f"{int(round(b['steps_over_1ms']))} of {int(b['steps'])} | {int(b['unconverged'])} |",
+            ""]
+if armadillo:
+    out += ["Armadillo (`taut-demo armadillo`, three 368-hex bodies in three islands, the first "
+            "second: drop, impact, toppling; target: <= 2 ms per body per 1/60 s frame), wall "
+            "time of a frame's steps per body; the 2-thread runs give bitwise the same states:",
+            "", "| h | threads | ms per body per frame: median | max | unconverged steps | "
+            "1 thread / 2 threads |", "|---|---:|---:|---:|---:|---:|"]
+    one = {}
+    for n, b in armadillo:
+        fields = dict(part.split(":") for part in n.split("/")[1:] if ":" in part)
+        if fields.get("threads") == "1":
+            one[fields.get("steps_per_frame")] = b["frame_ms_per_body"]
+    for n, b in armadillo:
+        fields = dict(part.split(":") for part in n.split("/")[1:] if ":" in part)
+        spf = fields.get("steps_per_frame", "?")
+        h = f"1/{60 * int(spf)} s" if spf.isdigit() else "?"
+        speedup = (fmt(one[spf] / b["frame_ms_per_body"]) if fields.get("threads") == "2" and
+                   spf in one else "–")
+        out.append(f"| {h} | {fields.get('threads', '?')} | {fmt(b['frame_ms_per_body'])} | "
+                   f"{fmt(b['frame_max_ms_per_body'])} | {int(b['unconverged'])} | {speedup} |")
+
 other = [n for n in median if not n.startswith(("BM_BeamTautVsBullet", "BM_BallDropTautVsBullet",
                                                  "BM_TetBeamScaling", "BM_PointDistance/",
-                                                 "BM_IslandSolver/"))]
+                                                 "BM_IslandSolver/", "BM_RealTime"))]
 if other:
     out += ["", "## Other benchmarks", "", "| benchmark | time (wall) | time (CPU) |",
             "|---|---:|---:|"]
