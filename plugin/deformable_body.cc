@@ -114,15 +114,18 @@ void DeformableBody::AddNodeForce(int node, const Vec3& force) {
   external_.segment<3>(3 * node) += force;
 }
 
+void DeformableBody::PrepareSystem() {
+  if (!kinds_changed_) return;
+  system_.Build(*model_, kinds_);
+  kinds_changed_ = false;
+}
+
 void DeformableBody::BeginStep(double h, const Vec3& gravity) {
   TAUT_DEMAND(std::isfinite(h) && h > 0.0, "body '", name(),
               "': time step must be finite and > 0 s, got ", h);
   TAUT_DEMAND(gravity.allFinite(), "body '", name(), "': gravity must be finite, got (",
               gravity.transpose(), ")");
-  if (kinds_changed_) {
-    system_.Build(*model_, kinds_);
-    kinds_changed_ = false;
-  }
+  PrepareSystem();
   x0_ = x_;
   v0_ = v_;
   // Forces at x0: external + elastic (updates rotations), checked, then + gravity.

@@ -161,6 +161,7 @@ void FingerScene::BeginPress(int p) {
   sqp_sum_ = sweep_sum_ = ms_sum_ = 0.0;
   UpdateBoneTravel(0.0);
   world().AttachNodesToRigidBody(finger_, bone_nodes_, bone_);
+  finger_->PrepareSystem();  // the symbolic analysis at set-up, not in the press's first step
 }
 
 void FingerScene::EndPress() {
