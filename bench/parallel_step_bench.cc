@@ -3,10 +3,13 @@
 // islands with rows: stage 6 in parallel, and stage 2), and four unlimited ones (no rows: only the
 // unconstrained steps of stage 2 in parallel). Median of 5 repetitions of wall time (real time:
 // the work is on several threads) over the same 40 steps after the same warm-up. Only the
-// simulation step is timed.
+// simulation step is timed. And one hex ball alone, whose element loops the pool splits.
 #include <benchmark/benchmark.h>
 
+#include "demos/scenes/bullet_world_holder.h"
+#include "demos/scenes/scene.h"
 #include "demos/scenes/tet_beam_scene.h"
+#include "plugin/hex_shapes.h"
 
 namespace taut {
 namespace {
@@ -55,6 +58,31 @@ BENCHMARK(BM_ParallelStepFourUnlimitedBeams)
     ->ArgNames({"threads", "cells"})
     ->ArgsProduct({{1, 2}, {10, 20}})
     ->Iterations(40)  // the same 40 steps for either thread count
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Repetitions(5)
+    ->ReportAggregatesOnly(true);
+
+// One body alone (no other body to step beside it): a soft hex ball of radius 1 m, cells of
+// 1/range(1) m (7: 1,472 hexes), resting on its fixed bottom cap in free space; the pool splits its
+// element loops (forces, rotations, assembly). range(0): threads. Wall time per world step.
+void BM_ParallelStepOneHexBall(benchmark::State& state) {
+  BulletWorldHolder holder;
+  DeformableBodySettings settings = MakeSceneBodySettings("ball", 1e5, 1000.0);
+  auto lattice = std::make_shared<HexLattice>(
+      MakeSphereHexLattice(1.0, 1.0 / static_cast<double>(state.range(1))));
+  DeformableBody* ball = holder.world.AddHexBody(lattice, settings);
+  ball->FixNodesWhere([](const Vec3& X) { return X.z() < -0.7; });
+  holder.world.SetThreadCount(static_cast<int>(state.range(0)));
+  const double dt = 1.0 / 240.0;
+  for (int i = 0; i < 5; ++i) holder.world.stepSimulation(dt, 1, dt);
+  for (auto _ : state) holder.world.stepSimulation(dt, 1, dt);
+  state.counters["hexes"] = ball->model().num_elements();
+}
+BENCHMARK(BM_ParallelStepOneHexBall)
+    ->ArgNames({"threads", "cells_per_m"})
+    ->ArgsProduct({{1, 2}, {4, 7}})
+    ->Iterations(20)  // the same 20 steps for either thread count
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime()
     ->Repetitions(5)

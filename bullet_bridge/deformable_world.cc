@@ -415,9 +415,19 @@ void DeformableWorldOf<BulletWorld>::BeginDeformableSteps(double h, int& begun) 
     pool_->Run(num_bodies, begin_step);
     return;
   }
+  // One body at a time: the pool (if any) splits each body's element loops instead, bitwise the
+  // same (plugin/element_loop_runner.h); lent for this stage only, where no pool task is running.
   for (auto& entry : bodies_) {
     ++begun;
-    entry->body().BeginStep(h, gravity);
+    DeformableBody& body = entry->body();
+    body.set_element_loop_runner(pool_.get());
+    try {
+      body.BeginStep(h, gravity);
+    } catch (...) {
+      body.set_element_loop_runner(nullptr);
+      throw;
+    }
+    body.set_element_loop_runner(nullptr);
   }
 }
 

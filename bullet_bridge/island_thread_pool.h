@@ -11,6 +11,8 @@
 #include <thread>
 #include <vector>
 
+#include "plugin/element_loop_runner.h"
+
 namespace taut {
 
 // Runs tasks 0..n-1 on num_threads threads, the calling thread one of them. Tasks are taken in
@@ -23,19 +25,22 @@ namespace taut {
 // Waits spin (yielding) for up to kSpinTime before they block: waking a blocked thread costs
 // 0.1-2 ms on a virtual machine (the idle vCPU has to be scheduled again), as much as a whole
 // body's unconstrained step, and a world step calls Run twice in quick succession.
-class IslandThreadPool {
+// It also splits one body's element loops (ElementLoopRunner) when the bodies are stepped one at
+// a time.
+class IslandThreadPool : public ElementLoopRunner {
  public:
   static constexpr std::chrono::microseconds kSpinTime{500};
 
   // Starts num_threads - 1 worker threads; throws InputError unless num_threads >= 1.
   explicit IslandThreadPool(int num_threads);
   // Stops and joins the workers.
-  ~IslandThreadPool();
+  ~IslandThreadPool() override;
   IslandThreadPool(const IslandThreadPool&) = delete;
   IslandThreadPool& operator=(const IslandThreadPool&) = delete;
 
   // Threads that run tasks, the caller included.
   int num_threads() const { return static_cast<int>(workers_.size()) + 1; }
+  int num_loop_threads() const override { return num_threads(); }
 
   // Calls task(i) once for every i in [0, num_tasks) and returns when every call has returned.
   // Every task runs even when another throws; then the exception of the lowest task index is
@@ -44,6 +49,11 @@ class IslandThreadPool {
   void Run(int num_tasks, Task& task) {
     RunErased(
         num_tasks, [](void* t, int i) { (*static_cast<Task*>(t))(i); }, &task);
+  }
+
+ protected:
+  void RunChunksErased(int num_chunks, ChunkCall call, void* chunk) override {
+    RunErased(num_chunks, call, chunk);
   }
 
  private:

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "plugin/common.h"
+#include "plugin/element_loop_runner.h"
 
 namespace taut {
 
@@ -32,6 +33,11 @@ using ElementMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eige
 class ElementModel {
  public:
   virtual ~ElementModel() = default;
+
+  // Threads that split the element loops of UpdateRotationsAndAddForces and AddScaledStiffness
+  // (null: the calling thread alone). The results are bitwise the same for any runner: elements
+  // are computed on any thread into their own slots, then summed and scattered in element order.
+  void set_loop_runner(ElementLoopRunner* runner) { runner_ = runner; }
 
   // Number of nodes of the body.
   virtual int num_nodes() const = 0;
@@ -91,6 +97,9 @@ class ElementModel {
   virtual const HexLattice* hex_lattice() const { return nullptr; }
   // The model itself when it is made of co-rotated tets (its rest data r_n), else null.
   virtual const TetElementModel* tet_model() const { return nullptr; }
+
+ protected:
+  ElementLoopRunner* runner_ = nullptr;
 };
 
 }  // namespace taut

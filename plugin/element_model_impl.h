@@ -16,6 +16,7 @@
 //   MakeContactSurface(mesh), MakeEmbeddedContactSurface(mesh, surface)
 #pragma once
 
+#include <algorithm>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -72,6 +73,20 @@ class ElementModelImpl : public ElementModel {
   const RestData& rest_data() const { return data_; }
 
  private:
+  // Elements per chunk of a split loop; loops over fewer than two chunks stay on one thread.
+  static constexpr int kChunkElements = 32;
+  bool SplitsLoops() const {
+    return runner_ != nullptr && runner_->num_loop_threads() > 1 &&
+           num_elements() >= 2 * kChunkElements;
+  }
+  int num_chunks() const { return (num_elements() + kChunkElements - 1) / kChunkElements; }
+  // UpdateRotationsAndAddForces on the runner's threads: R, f_e and U_e per element into
+  // rotations_, element_forces_ and element_energy_, then the serial loop's sums.
+  double UpdateRotationsAndAddForcesSplit(const VecX& x, VecX& f);
+  // AddScaledStiffness on the runner's threads: the blocks of scale R K0 R^T per element into
+  // stiffness_blocks_, then added to `values` in the serial loop's order.
+  void AddScaledStiffnessSplit(double scale, const std::vector<int>& index_map,
+                               double* values) const;
   // f(node of a) += forces[a] for the nodes of element e.
   void ScatterElement(int e, const Nodes& forces, VecX& f) const;
 
@@ -79,6 +94,10 @@ class ElementModelImpl : public ElementModel {
   RestData data_;
   VecX rest_positions_;
   std::vector<Mat3> rotations_;  // (num_elements)
+  // Per-element results of the split loops (allocated on their first use).
+  std::vector<Nodes> element_forces_;
+  std::vector<double> element_energy_;
+  mutable std::vector<double> stiffness_blocks_;  // 9 kNodes^2 per element, the serial order
 };
 
 template <typename Traits>
@@ -115,6 +134,7 @@ void ElementModelImpl<Traits>::CalcLumpedMass(double density, VecX& mass) const 
 
 template <typename Traits>
 double ElementModelImpl<Traits>::UpdateRotationsAndAddForces(const VecX& x, VecX& f) {
+  if (SplitsLoops()) return UpdateRotationsAndAddForcesSplit(x, f);
   double energy = 0.0;
   for (int e = 0; e < num_elements(); ++e) {
     // gather -> local (R, forces, energy) -> scatter
@@ -124,6 +144,31 @@ double ElementModelImpl<Traits>::UpdateRotationsAndAddForces(const VecX& x, VecX
     const Nodes fe = Traits::CalcForces(data_, e, xe, frame);
     energy += Traits::CalcEnergy(data_, e, xe, frame);
     ScatterElement(e, fe, f);
+  }
+  return energy;
+}
+
+template <typename Traits>
+double ElementModelImpl<Traits>::UpdateRotationsAndAddForcesSplit(const VecX& x, VecX& f) {
+  const int ne = num_elements();
+  element_forces_.resize(ne);
+  element_energy_.resize(ne);
+  auto chunk = [&](int c) {
+    const int end = std::min(ne, (c + 1) * kChunkElements);
+    for (int e = c * kChunkElements; e < end; ++e) {
+      const Nodes xe = GatherElement(x, e);
+      const typename Traits::Frame frame = Traits::CalcFrame(data_, e, xe);
+      rotations_[e] = frame.R;
+      element_forces_[e] = Traits::CalcForces(data_, e, xe, frame);
+      element_energy_[e] = Traits::CalcEnergy(data_, e, xe, frame);
+    }
+  };
+  runner_->RunChunks(num_chunks(), chunk);
+  // The serial loop's sum and scatter, in its order: bitwise its result.
+  double energy = 0.0;
+  for (int e = 0; e < ne; ++e) {
+    energy += element_energy_[e];
+    ScatterElement(e, element_forces_[e], f);
   }
   return energy;
 }
@@ -146,6 +191,7 @@ void ElementModelImpl<Traits>::AddHeldRotationForces(const VecX& x, VecX& f) con
 template <typename Traits>
 void ElementModelImpl<Traits>::AddScaledStiffness(double scale, const std::vector<int>& index_map,
                                                   double* values) const {
+  if (SplitsLoops()) return AddScaledStiffnessSplit(scale, index_map, values);
   constexpr int kEntries = 9 * kNodes * kNodes;
   for (int e = 0; e < num_elements(); ++e) {
     const Mat3& R = rotations_[e];
@@ -159,6 +205,34 @@ void ElementModelImpl<Traits>::AddScaledStiffness(double scale, const std::vecto
       }
     }
   }
+}
+
+template <typename Traits>
+void ElementModelImpl<Traits>::AddScaledStiffnessSplit(double scale,
+                                                       const std::vector<int>& index_map,
+                                                       double* values) const {
+  constexpr int kEntries = 9 * kNodes * kNodes;
+  const int ne = num_elements();
+  stiffness_blocks_.resize(static_cast<size_t>(ne) * kEntries);
+  auto chunk = [&](int c) {
+    const int end = std::min(ne, (c + 1) * kChunkElements);
+    for (int e = c * kChunkElements; e < end; ++e) {
+      const Mat3& R = rotations_[e];
+      double* block = stiffness_blocks_.data() + static_cast<size_t>(kEntries) * e;
+      for (int a = 0; a < kNodes; ++a)
+        for (int b = 0; b < kNodes; ++b, block += 9) {
+          // Block (a,b) of R K0 R^T, entries column-major (the serial loop's expression).
+          const Mat3 K = scale * (R * Traits::RestStiffnessBlock(data_, e, a, b) * R.transpose());
+          std::copy(K.data(), K.data() + 9, block);
+        }
+    }
+  };
+  runner_->RunChunks(num_chunks(), chunk);
+  // The serial loop's additions, in its order (element, block, entry).
+  const int* map = index_map.data();
+  const double* block = stiffness_blocks_.data();
+  for (size_t k = 0; k < stiffness_blocks_.size(); ++k)
+    if (map[k] >= 0) values[map[k]] += block[k];
 }
 
 template <typename Traits>
