@@ -78,10 +78,13 @@ double SqpSolver::CalcMerit(double h, const std::vector<IslandBody*>& bodies,
 KktResiduals SqpSolver::CalcFullStepCertificate(double h, const std::vector<IslandBody*>& bodies,
                                                 const std::vector<ConstraintSource*>& sources,
                                                 const SqpSettings& settings, StepStats& stats) {
-  const auto t_rows = std::chrono::steady_clock::now();
   const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
-  full_violation_ = full_rows_.Collect(h, bodies, sources, v_qp_, distance_scale);
-  stats.ms_rows += MsSince(t_rows);
+  if (!full_rows_at_v_qp_) {  // else the look-ahead pass collected them at this v_QP
+    const auto t_rows = std::chrono::steady_clock::now();
+    full_violation_ = full_rows_.Collect(h, bodies, sources, v_qp_, distance_scale);
+    full_rows_at_v_qp_ = true;
+    stats.ms_rows += MsSince(t_rows);
+  }
   rows_.Store(lambda_qp_, qp_keyed_);
   full_rows_.WarmStart(qp_keyed_, full_lambda_);
   return CalcKktResiduals(bodies, full_rows_, full_lambda_, v_qp_, h, distance_scale, scratch_);
@@ -92,21 +95,16 @@ bool SqpSolver::HasTightDistanceRows(const KktResiduals& kkt, const SqpSettings&
          settings.warm_stop_distance_factor * settings.violation_tolerance;
 }
 
-bool SqpSolver::AcceptFullStep(double h, const std::vector<IslandBody*>& bodies,
-                               const std::vector<ConstraintSource*>& sources,
-                               const SqpSettings& settings, double residual, double violation,
-                               StepStats& stats) {
+bool SqpSolver::IsCertifiedWithTightRows(const KktResiduals& full, const SqpSettings& settings) {
+  return IsCertified(full, settings.violation_tolerance, settings.stationarity_tolerance) &&
+         HasTightDistanceRows(full, settings);
+}
+
+bool SqpSolver::AcceptsFullStepResidual(const KktResiduals& full, const SqpSettings& settings,
+                                        double residual, double violation) {
   // The l1 merit rejects full steps that the SQP needs near convergence (with Coulomb friction
   // the step need not lower the energy term; curved rows add second-order violation), and merit
   // steps of 1/2 converge only linearly. The certificate is the measure of progress here.
-  const KktResiduals full = CalcFullStepCertificate(h, bodies, sources, settings, stats);
-  // A full step certified with its distance rows tight is the iterate the SQP stops at next. From
-  // a warm start already at the answer the QP step is ~0: the merit's sufficient decrease fails
-  // on round-off and its residual cannot fall by 10 % (the finger's held presses: five halvings
-  // to alpha = 1/32, half of their step time).
-  if (IsCertified(full, settings.violation_tolerance, settings.stationarity_tolerance) &&
-      HasTightDistanceRows(full, settings))
-    return true;
   const double bound =
       std::max(violation, settings.full_step_violation_factor * settings.violation_tolerance);
   return CalcCertificateResidual(full, settings.violation_tolerance,
@@ -372,13 +370,26 @@ bool SqpSolver::TakeRestorationStep(double h, const std::vector<IslandBody*>& bo
 }
 
 // Merit backtracking from (v_k, lambda_k) towards (v_QP, lambda_QP), or the full step taken on its
-// own certificate (AcceptFullStep). Returns the step length.
+// own certificate. Returns the step length.
 double SqpSolver::TakeMeritStep(double h, const std::vector<IslandBody*>& bodies,
                                 const std::vector<ConstraintSource*>& sources,
                                 const SqpSettings& settings, const KktResiduals& kkt, double& rho,
                                 StepStats& stats) {
   const size_t nb = bodies.size();
   rho = std::max(rho, 2.0 * lambda_qp_.cwiseAbs().maxCoeff());
+  // The full step's certificate first. Certified with its distance rows tight, the full step is
+  // the iterate the SQP stops at next, and the merit search would take it either way (a
+  // decrease at alpha = 1, or else as a certificate step): taken without the merit's two
+  // violation sums over every limited element. From a warm start already at the answer the QP
+  // step is ~0 and the merit's decrease fails on round-off (the finger's held presses).
+  KktResiduals full;
+  if (settings.certificate_steps) {
+    full = CalcFullStepCertificate(h, bodies, sources, settings, stats);
+    if (IsCertifiedWithTightRows(full, settings)) {
+      TakeFullStep();
+      return 1.0;
+    }
+  }
   const double phi_k = CalcMerit(h, bodies, sources, v_k_, rho);
   for (size_t b = 0; b < nb; ++b) dv_[b] = v_qp_[b] - v_k_[b];
   const double step_norm = EnergyNormSquared(bodies, dv_, scratch_);
@@ -391,17 +402,13 @@ double SqpSolver::TakeMeritStep(double h, const std::vector<IslandBody*>& bodies
     for (size_t b = 0; b < nb; ++b) v_trial_[b] = v_k_[b] + alpha * (v_qp_[b] - v_k_[b]);
     decreased = CalcMerit(h, bodies, sources, v_trial_, rho) <= phi_k - 1e-4 * alpha * step_norm;
     if (decreased) break;
-    certificate_step =
-        halving == 0 && settings.certificate_steps &&
-        AcceptFullStep(h, bodies, sources, settings, residual_k, kkt.max_primal(), stats);
+    certificate_step = halving == 0 && settings.certificate_steps &&
+                       AcceptsFullStepResidual(full, settings, residual_k, kkt.max_primal());
     if (certificate_step) break;
   }
   if (!decreased && !certificate_step) return 0.0;  // no trial lowers the merit: v_k stays
   if (certificate_step) {
-    // (v_QP, lambda_QP) exactly, so the next iteration takes the rows just collected there.
-    v_k_ = v_qp_;
-    lambda_ = lambda_qp_;
-    full_rows_at_v_k_ = true;
+    TakeFullStep();
   } else {
     for (size_t b = 0; b < nb; ++b) v_k_[b] += alpha * (v_qp_[b] - v_k_[b]);
     lambda_ += alpha * (lambda_qp_ - lambda_);
@@ -409,6 +416,13 @@ double SqpSolver::TakeMeritStep(double h, const std::vector<IslandBody*>& bodies
     full_rows_at_v_k_ = alpha == 1.0 && full_rows_at_v_qp_;
   }
   return alpha;
+}
+
+void SqpSolver::TakeFullStep() {
+  // (v_QP, lambda_QP) exactly, so the next iteration takes the rows just collected there.
+  v_k_ = v_qp_;
+  lambda_ = lambda_qp_;
+  full_rows_at_v_k_ = true;
 }
 
 }  // namespace taut

@@ -107,14 +107,17 @@ class SqpSolver {
                                        const SqpSettings& settings, StepStats& stats);
   // Distance rows (contacts, joints) of `kkt` within warm_stop_distance_factor of their tolerance.
   static bool HasTightDistanceRows(const KktResiduals& kkt, const SqpSettings& settings);
+  // The full QP step's certificate passes with its distance rows within
+  // warm_stop_distance_factor of their tolerance: the iterate the SQP stops at.
+  static bool IsCertifiedWithTightRows(const KktResiduals& full, const SqpSettings& settings);
   // True when the full QP step may be taken although the merit rejects it
-  // (SqpSettings::certificate_steps): it is certified with its distance rows within
-  // warm_stop_distance_factor of their tolerance, or its certificate's residual is below
-  // 0.9 x `residual` and its worst violation below max(`violation`, full_step_violation_factor x
+  // (SqpSettings::certificate_steps): its certificate `full`'s residual is below 0.9 x
+  // `residual` and its worst violation below max(`violation`, full_step_violation_factor x
   // tolerance).
-  bool AcceptFullStep(double h, const std::vector<IslandBody*>& bodies,
-                      const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
-                      double residual, double violation, StepStats& stats);
+  static bool AcceptsFullStepResidual(const KktResiduals& full, const SqpSettings& settings,
+                                      double residual, double violation);
+  // (v_k, lambda_k) <- (v_QP, lambda_QP), the rows at v_QP kept for the next iteration.
+  void TakeFullStep();
 
   IslandRows rows_;
   std::vector<PgsRow> pgs_rows_;
