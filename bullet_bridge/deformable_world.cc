@@ -20,6 +20,21 @@
 namespace taut {
 
 namespace {
+// Lends `runner` to a body's element loops for one scope (also when the step throws): only while
+// no pool task runs, since the pool's Run is not reentrant.
+class LentLoopRunner {
+ public:
+  LentLoopRunner(DeformableBody& body, ElementLoopRunner* runner) : body_(body) {
+    body_.set_element_loop_runner(runner);
+  }
+  ~LentLoopRunner() { body_.set_element_loop_runner(nullptr); }
+  LentLoopRunner(const LentLoopRunner&) = delete;
+  LentLoopRunner& operator=(const LentLoopRunner&) = delete;
+
+ private:
+  DeformableBody& body_;
+};
+
 // Milliseconds since `start`.
 double MsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
@@ -419,15 +434,8 @@ void DeformableWorldOf<BulletWorld>::BeginDeformableSteps(double h, int& begun) 
   // same (plugin/element_loop_runner.h); lent for this stage only, where no pool task is running.
   for (auto& entry : bodies_) {
     ++begun;
-    DeformableBody& body = entry->body();
-    body.set_element_loop_runner(pool_.get());
-    try {
-      body.BeginStep(h, gravity);
-    } catch (...) {
-      body.set_element_loop_runner(nullptr);
-      throw;
-    }
-    body.set_element_loop_runner(nullptr);
+    const LentLoopRunner lent(entry->body(), pool_.get());
+    entry->body().BeginStep(h, gravity);
   }
 }
 

@@ -87,6 +87,14 @@ class ElementModelImpl : public ElementModel {
   // stiffness_blocks_, then added to `values` in the serial loop's order.
   void AddScaledStiffnessSplit(double scale, const std::vector<int>& index_map,
                                double* values) const;
+  // The per-element kernel of UpdateRotationsAndAddForces: R_e at x into rotations_, f_e into
+  // `forces`; returns U_e (gather -> local R, forces, energy).
+  double UpdateElement(int e, const VecX& x, Nodes& forces);
+  // The per-element kernel of AddScaledStiffness: block (a, b) of scale R_e K0_e R_e^T.
+  Mat3 CalcScaledStiffnessBlock(int e, int a, int b, double scale) const {
+    const Mat3& R = rotations_[e];
+    return scale * (R * Traits::RestStiffnessBlock(data_, e, a, b) * R.transpose());
+  }
   // f(node of a) += forces[a] for the nodes of element e.
   void ScatterElement(int e, const Nodes& forces, VecX& f) const;
 
@@ -136,16 +144,21 @@ template <typename Traits>
 double ElementModelImpl<Traits>::UpdateRotationsAndAddForces(const VecX& x, VecX& f) {
   if (SplitsLoops()) return UpdateRotationsAndAddForcesSplit(x, f);
   double energy = 0.0;
+  Nodes fe;
   for (int e = 0; e < num_elements(); ++e) {
-    // gather -> local (R, forces, energy) -> scatter
-    const Nodes xe = GatherElement(x, e);
-    const typename Traits::Frame frame = Traits::CalcFrame(data_, e, xe);
-    rotations_[e] = frame.R;
-    const Nodes fe = Traits::CalcForces(data_, e, xe, frame);
-    energy += Traits::CalcEnergy(data_, e, xe, frame);
+    energy += UpdateElement(e, x, fe);
     ScatterElement(e, fe, f);
   }
   return energy;
+}
+
+template <typename Traits>
+double ElementModelImpl<Traits>::UpdateElement(int e, const VecX& x, Nodes& forces) {
+  const Nodes xe = GatherElement(x, e);
+  const typename Traits::Frame frame = Traits::CalcFrame(data_, e, xe);
+  rotations_[e] = frame.R;
+  forces = Traits::CalcForces(data_, e, xe, frame);
+  return Traits::CalcEnergy(data_, e, xe, frame);
 }
 
 template <typename Traits>
@@ -155,13 +168,8 @@ double ElementModelImpl<Traits>::UpdateRotationsAndAddForcesSplit(const VecX& x,
   element_energy_.resize(ne);
   auto chunk = [&](int c) {
     const int end = std::min(ne, (c + 1) * kChunkElements);
-    for (int e = c * kChunkElements; e < end; ++e) {
-      const Nodes xe = GatherElement(x, e);
-      const typename Traits::Frame frame = Traits::CalcFrame(data_, e, xe);
-      rotations_[e] = frame.R;
-      element_forces_[e] = Traits::CalcForces(data_, e, xe, frame);
-      element_energy_[e] = Traits::CalcEnergy(data_, e, xe, frame);
-    }
+    for (int e = c * kChunkElements; e < end; ++e)
+      element_energy_[e] = UpdateElement(e, x, element_forces_[e]);
   };
   runner_->RunChunks(num_chunks(), chunk);
   // The serial loop's sum and scatter, in its order: bitwise its result.
@@ -194,12 +202,10 @@ void ElementModelImpl<Traits>::AddScaledStiffness(double scale, const std::vecto
   if (SplitsLoops()) return AddScaledStiffnessSplit(scale, index_map, values);
   constexpr int kEntries = 9 * kNodes * kNodes;
   for (int e = 0; e < num_elements(); ++e) {
-    const Mat3& R = rotations_[e];
     const int* map = index_map.data() + kEntries * e;
     for (int a = 0; a < kNodes; ++a) {
       for (int b = 0; b < kNodes; ++b, map += 9) {
-        // Block (a,b) of R K0 R^T, entries column-major.
-        const Mat3 K = scale * (R * Traits::RestStiffnessBlock(data_, e, a, b) * R.transpose());
+        const Mat3 K = CalcScaledStiffnessBlock(e, a, b, scale);  // entries column-major
         for (int k = 0; k < 9; ++k)
           if (map[k] >= 0) values[map[k]] += K.data()[k];
       }
@@ -217,12 +223,10 @@ void ElementModelImpl<Traits>::AddScaledStiffnessSplit(double scale,
   auto chunk = [&](int c) {
     const int end = std::min(ne, (c + 1) * kChunkElements);
     for (int e = c * kChunkElements; e < end; ++e) {
-      const Mat3& R = rotations_[e];
       double* block = stiffness_blocks_.data() + static_cast<size_t>(kEntries) * e;
       for (int a = 0; a < kNodes; ++a)
         for (int b = 0; b < kNodes; ++b, block += 9) {
-          // Block (a,b) of R K0 R^T, entries column-major (the serial loop's expression).
-          const Mat3 K = scale * (R * Traits::RestStiffnessBlock(data_, e, a, b) * R.transpose());
+          const Mat3 K = CalcScaledStiffnessBlock(e, a, b, scale);
           std::copy(K.data(), K.data() + 9, block);
         }
     }
