@@ -18,6 +18,14 @@ class DeformableIslandBody final : public IslandBody {
   void SolveSystemColumns(Eigen::Ref<MatX> columns) const override {
     body_->SolveSystemColumns(columns);
   }
+  bool supports_half_solve() const override { return body_->supports_half_solve(); }
+  void HalfSolveSystemColumns(const Eigen::Ref<const MatX>& rhs, MatX& z) const override {
+    body_->HalfSolveSystemColumns(rhs, z);
+  }
+  void CompleteHalfSolve(const VecX& z, VecX& out) const override {
+    out.resize(3 * num_blocks());
+    body_->CompleteHalfSolve(z, out);
+  }
   void SolveSystemApproximately(VecX& rhs) const override { body_->SolveSystemApproximately(rhs); }
   void ApplySystemMatrix(const VecX& v, VecX& out) const override {
     body_->ApplySystemMatrix(v, out);

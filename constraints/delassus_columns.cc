@@ -3,6 +3,34 @@
 #include <algorithm>
 
 namespace taut {
+namespace {
+
+// Depth of one dense product below. Eigen splits a product's depth k into blocks of a size it
+// derives from the CPU's L1 cache (at least ~500 for double with a 32 KB L1) and sums the blocks'
+// partial results, so a deeper product's last bits would depend on the machine. Chunks of this
+// depth are summed here in a fixed order instead: the same bits on every CPU (determinism pins).
+constexpr Eigen::Index kProductDepthChunk = 256;
+
+// out = a^T b (a: d x m, b: d x k), the depth d summed in chunks of kProductDepthChunk.
+void MultiplyTransposedByChunks(const MatX& a, const MatX& b, MatX& out) {
+  out.setZero(a.cols(), b.cols());
+  for (Eigen::Index r = 0; r < a.rows(); r += kProductDepthChunk) {
+    const Eigen::Index d = std::min(kProductDepthChunk, a.rows() - r);
+    out.noalias() += a.middleRows(r, d).transpose() * b.middleRows(r, d);
+  }
+}
+
+// out = a^T a, its lower triangle by rank updates of kProductDepthChunk rows, mirrored.
+void MultiplyGramByChunks(const MatX& a, MatX& out) {
+  out.setZero(a.cols(), a.cols());
+  for (Eigen::Index r = 0; r < a.rows(); r += kProductDepthChunk) {
+    const Eigen::Index d = std::min(kProductDepthChunk, a.rows() - r);
+    out.selfadjointView<Eigen::Lower>().rankUpdate(a.middleRows(r, d).transpose());
+  }
+  out.triangularView<Eigen::StrictlyUpper>() = out.transpose();
+}
+
+}  // namespace
 
 bool DelassusColumns::ColumnSource::operator==(const ColumnSource& o) const {
   if (key != o.key || count != o.count) return false;
@@ -41,43 +69,145 @@ int DelassusColumns::FindKept(const BodyColumns& body, const ColumnSource& sourc
 }
 
 // Per body: kept columns copied, the others scattered as J^T into `fresh`, solved at once, and
-// placed; then the new columns become the kept ones.
+// placed; W_b built; then the new columns become the kept ones.
 void DelassusColumns::Build(const std::vector<IslandBody*>& bodies, const IslandRows& rows) {
   if (bodies_.size() < bodies.size()) bodies_.resize(bodies.size());
   for (size_t b = 0; b < bodies.size(); ++b) {
     BodyColumns& body = bodies_[b];
     const std::vector<int>& body_rows = rows.body_rows(static_cast<int>(b));
-    const int n = 3 * bodies[b]->num_blocks(), m = static_cast<int>(body_rows.size());
-    body.next.resize(n, m);
+    const bool half = bodies[b]->supports_half_solve();
+    if (half != body.half || body.num_blocks != bodies[b]->num_blocks()) {
+      // another body at this index: nothing to keep
+      body.half = half;
+      body.num_blocks = bodies[b]->num_blocks();
+      body.sources.clear();
+      body.by_key.clear();
+    }
+    const int n_full = 3 * bodies[b]->num_blocks(), m = static_cast<int>(body_rows.size());
+    const bool keep = !body.sources.empty();
     body.next_sources.resize(m);
+    body.kept_from.assign(m, -1);
     body.to_solve.clear();
     for (int k = 0; k < m; ++k) {
       body.next_sources[k] = CalcSource(rows[body_rows[k]], static_cast<int>(b));
-      const int kept = body.Y.rows() == n ? FindKept(body, body.next_sources[k]) : -1;
-      if (kept >= 0) {
-        body.next.col(k) = body.Y.col(kept);
+      const int kept = keep ? FindKept(body, body.next_sources[k]) : -1;
+      body.kept_from[k] = kept;
+      if (kept >= 0)
         columns_kept_++;
-      } else {
+      else
         body.to_solve.push_back(k);
-      }
     }
     const int num_fresh = static_cast<int>(body.to_solve.size());
     if (num_fresh > 0) {
-      body.fresh.setZero(n, num_fresh);
+      body.fresh.setZero(n_full, num_fresh);
       for (int f = 0; f < num_fresh; ++f) {
         const ColumnSource& s = body.next_sources[body.to_solve[f]];
         for (int i = 0; i < s.count; ++i) body.fresh.col(f).segment<3>(3 * s.blocks[i]) += s.J[i];
       }
-      bodies[b]->SolveSystemColumns(body.fresh);
-      for (int f = 0; f < num_fresh; ++f) body.next.col(body.to_solve[f]) = body.fresh.col(f);
+      SolveFresh(*bodies[b], body);
       columns_solved_ += num_fresh;
     }
+    const MatX& solved = half ? body.fresh_solved : body.fresh;
+    const Eigen::Index n = num_fresh > 0 ? solved.rows() : body.Y.rows();
+    body.next.resize(n, m);
+    int f = 0;
+    for (int k = 0; k < m; ++k) {
+      if (body.kept_from[k] >= 0)
+        body.next.col(k) = body.Y.col(body.kept_from[k]);
+      else
+        body.next.col(k) = solved.col(f++);
+    }
+    BuildW(rows, body_rows, static_cast<int>(b), body);
     std::swap(body.Y, body.next);
+    std::swap(body.W, body.next_W);
     std::swap(body.sources, body.next_sources);
     body.by_key.resize(m);
     for (int k = 0; k < m; ++k) body.by_key[k] = {body.sources[k].key, k};
     std::sort(body.by_key.begin(), body.by_key.end());
   }
+}
+
+void DelassusColumns::SolveFresh(const IslandBody& island_body, BodyColumns& body) {
+  if (body.half)
+    island_body.HalfSolveSystemColumns(body.fresh, body.fresh_solved);
+  else
+    island_body.SolveSystemColumns(body.fresh);
+}
+
+// Half solves: W_b(i, k) = Z_i . Z_k, only over the rows where a fresh column is nonzero (the
+// union of their elimination-tree paths). Full columns: W_b(i, k) = J_i Y_k, J sparse over a
+// row's blocks (a 1x3 times 3-row product per block).
+void DelassusColumns::BuildW(const IslandRows& rows, const std::vector<int>& body_rows, int b,
+                             BodyColumns& body) {
+  const int m = static_cast<int>(body_rows.size());
+  body.next_W.resize(m, m);
+  if (!body.half) {
+    for (int i = 0; i < m; ++i) {
+      body.next_W.row(i).setZero();
+      rows[body_rows[i]].ForEachEntry([&](int on, int block, const Vec3& J) {
+        if (on == b)
+          body.next_W.row(i).noalias() += J.transpose() * body.next.middleRows<3>(3 * block);
+      });
+    }
+    return;
+  }
+  for (int k = 0; k < m; ++k) {
+    if (body.kept_from[k] < 0) continue;
+    for (int i = 0; i < m; ++i)
+      if (body.kept_from[i] >= 0) body.next_W(i, k) = body.W(body.kept_from[i], body.kept_from[k]);
+  }
+  const int num_fresh = static_cast<int>(body.to_solve.size());
+  if (num_fresh == 0) return;
+  // Runs [start, end) of rows where a fresh column is nonzero (whole supernodes of the paths).
+  const MatX& fresh = body.fresh_solved;
+  std::vector<int>& runs = body.nonzero_rows;
+  runs.clear();
+  int num_nonzero = 0;
+  for (int r = 0; r < static_cast<int>(fresh.rows()); ++r) {
+    bool nonzero = false;
+    for (int f = 0; f < num_fresh && !nonzero; ++f) nonzero = fresh(r, f) != 0.0;
+    if (!nonzero) continue;
+    if (!runs.empty() && runs.back() == r)
+      runs.back() = r + 1;
+    else
+      runs.insert(runs.end(), {r, r + 1});
+    ++num_nonzero;
+  }
+  body.gathered.resize(num_nonzero, m);
+  body.gathered_fresh.resize(num_nonzero, num_fresh);
+  for (size_t q = 0, at = 0; q < runs.size(); q += 2) {
+    const int start = runs[q], length = runs[q + 1] - runs[q];
+    body.gathered.middleRows(at, length) = body.next.middleRows(start, length);
+    body.gathered_fresh.middleRows(at, length) = fresh.middleRows(start, length);
+    at += length;
+  }
+  if (num_fresh == m) {  // every column fresh: W_b = Z^T Z, one triangle (half the products)
+    MultiplyGramByChunks(body.gathered, body.next_W);
+    return;
+  }
+  // (m x num_fresh) Z^T Z_fresh: the fresh columns of W_b and, by symmetry, its fresh rows.
+  MultiplyTransposedByChunks(body.gathered, body.gathered_fresh, body.cross);
+  for (int f = 0; f < num_fresh; ++f) {
+    const int k = body.to_solve[f];
+    body.next_W.col(k) = body.cross.col(f);
+    body.next_W.row(k) = body.cross.col(f).transpose();
+  }
+}
+
+void DelassusColumns::AddImpulseVelocity(int b, const IslandBody& body,
+                                         const std::vector<int>& body_rows, const VecX& lambda,
+                                         VecX& v) const {
+  const BodyColumns& columns = bodies_[b];
+  if (!columns.half) {
+    for (size_t i = 0; i < body_rows.size(); ++i) v += columns.Y.col(i) * lambda[body_rows[i]];
+    return;
+  }
+  if (body_rows.empty()) return;
+  columns.impulse.setZero(columns.Y.rows());
+  for (size_t i = 0; i < body_rows.size(); ++i)
+    columns.impulse += columns.Y.col(i) * lambda[body_rows[i]];
+  body.CompleteHalfSolve(columns.impulse, columns.impulse_velocity);
+  v += columns.impulse_velocity;
 }
 
 }  // namespace taut

@@ -28,6 +28,21 @@ class IslandBody {
   virtual void set_v(const VecX& v) = 0;
   // columns <- A^-1 columns (zero on blocks that do not move freely).
   virtual void SolveSystemColumns(Eigen::Ref<MatX> columns) const = 0;
+  // The halves of A^-1 for bodies with many blocks (docs/math.md §5.7): z = G rhs for a factor G
+  // with A^-1 = G^T G (deformable: G = D^-1/2 L^-1 P of A's sparse factor), so the Delassus block
+  // J A^-1 J^T = (G J^T)^T (G J^T) and A^-1 J^T c = G^T (G J^T c). Default: not supported.
+  virtual bool supports_half_solve() const { return false; }
+  virtual void HalfSolveSystemColumns(const Eigen::Ref<const MatX>& rhs, MatX& z) const {
+    (void)rhs;
+    (void)z;
+    throw InputError("island body: half solves are not supported");
+  }
+  // out = G^T z (3 * num_blocks; zero on blocks that do not move freely).
+  virtual void CompleteHalfSolve(const VecX& z, VecX& out) const {
+    (void)z;
+    (void)out;
+    throw InputError("island body: half solves are not supported");
+  }
   // rhs <- an approximation of A^-1 rhs, for starting guesses (default: exact).
   virtual void SolveSystemApproximately(VecX& rhs) const { SolveSystemColumns(rhs); }
   // out = A v (zero on blocks that do not move freely).

@@ -37,21 +37,14 @@ void SqpSolver::CalcPositions(double h, const std::vector<IslandBody*>& bodies,
 void SqpSolver::BuildDelassus(const std::vector<IslandBody*>& bodies) {
   const int m = rows_.size();
   W_.setZero(m, m);
-  // Y_b = A_b^-1 J_b^T, kept across this step's SQP iterations where a row's J is unchanged.
+  // W_b = J_b A_b^-1 J_b^T per body, its columns kept across this step's SQP iterations where a
+  // row's J is unchanged.
   columns_.Build(bodies, rows_);
   for (size_t b = 0; b < bodies.size(); ++b) {
     const std::vector<int>& rows = rows_.body_rows(static_cast<int>(b));
-    if (rows.empty()) continue;
-    const int body = static_cast<int>(b);
-    const MatX& Y = columns_.Y(body);
-    // W_c. += J_cb Y_b (J sparse over a row's blocks): a 1x3 times 3xm product per block.
-    for (size_t i = 0; i < rows.size(); ++i) {
-      w_row_.setZero(static_cast<int>(rows.size()));
-      rows_[rows[i]].ForEachEntry([&](int on, int block, const Vec3& J) {
-        if (on == body) w_row_.noalias() += J.transpose() * Y.middleRows<3>(3 * block);
-      });
-      for (size_t k = 0; k < rows.size(); ++k) W_(rows[i], rows[k]) += w_row_[k];
-    }
+    const MatX& W_b = columns_.W(static_cast<int>(b));
+    for (size_t i = 0; i < rows.size(); ++i)
+      for (size_t k = 0; k < rows.size(); ++k) W_(rows[i], rows[k]) += W_b(i, k);
   }
   // Symmetrize (W is J A^-1 J^T; round-off makes it slightly asymmetric).
   W_ = 0.5 * (W_ + W_.transpose()).eval();
@@ -315,13 +308,12 @@ void SqpSolver::SolveQp(const SqpSettings& settings, StepStats& stats) {
   }
 }
 
-// v_QP = v* + Y lambda_QP (restoration: v_k + Y dlambda).
+// v_QP = v* + A^-1 J^T lambda_QP (restoration: v_k + A^-1 J^T dlambda).
 void SqpSolver::CalcQpVelocities(const std::vector<IslandBody*>& bodies, bool restoring) {
   for (size_t b = 0; b < bodies.size(); ++b) {
     v_qp_[b] = restoring ? v_k_[b] : bodies[b]->v_star();
-    const std::vector<int>& rows = rows_.body_rows(static_cast<int>(b));
-    const MatX& Y = columns_.Y(static_cast<int>(b));
-    for (size_t i = 0; i < rows.size(); ++i) v_qp_[b] += Y.col(i) * lambda_qp_[rows[i]];
+    columns_.AddImpulseVelocity(static_cast<int>(b), *bodies[b],
+                                rows_.body_rows(static_cast<int>(b)), lambda_qp_, v_qp_[b]);
   }
 }
 

@@ -135,7 +135,6 @@ class SqpSolver {
   bool full_rows_at_v_qp_ = false;  // full_rows_ were collected at the current v_QP
   VecX full_lambda_;                // lambda_QP on full_rows_
   KeyedMultipliers qp_keyed_;       // lambda_QP by key
-  Eigen::RowVectorXd w_row_;        // one row of W being assembled
   std::vector<VecX> v_k_, v_qp_, v_trial_, dv_;
   VecX scratch_, jt_;                // 3N work vectors (A dv, J^T lambda), reused across steps
   KeyedMultipliers previous_;        // last step's multipliers by key

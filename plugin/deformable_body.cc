@@ -169,6 +169,11 @@ void DeformableBody::SolveSystemColumns(Eigen::Ref<MatX> rhs) {
   system_.SolveColumns(rhs);
 }
 
+void DeformableBody::HalfSolveSystemColumns(const Eigen::Ref<const MatX>& rhs, MatX& z) {
+  system_.EnsureCurrentFactor(name());
+  system_.HalfSolveColumns(rhs, z);
+}
+
 void DeformableBody::EndStep(double h) {
   CheckVelocities("end of step");
   x_ = x0_ + h * v_;

@@ -111,6 +111,14 @@ class DeformableBody {
   void SolveSystem(Eigen::Ref<VecX> rhs);
   // Same for every column of a 3N x k matrix.
   void SolveSystemColumns(Eigen::Ref<MatX> rhs);
+  // The halves of A^-1 (ImplicitSystem::HalfSolveColumns), factoring this step's A first like
+  // SolveSystem: z = D^-1/2 L^-1 P rhs with rhs^T A^-1 rhs = z^T z, and out = A^-1 rhs c from
+  // z c. Only when supports_half_solve().
+  bool supports_half_solve() const { return system_.supports_half_solve(); }
+  void HalfSolveSystemColumns(const Eigen::Ref<const MatX>& rhs, MatX& z);
+  void CompleteHalfSolve(const VecX& z, Eigen::Ref<VecX> out) const {
+    system_.CompleteHalfSolve(z, out);
+  }
   // rhs <- P^-1 rhs with the factor held (this step's A or a kept earlier one): an approximate
   // A^-1 for starting guesses that leaves the next step free to reuse the factor
   // (ImplicitSystem::SolveApproximately).

@@ -209,6 +209,28 @@ void ImplicitSystem::SolveColumns(Eigen::Ref<MatX> rhs) const {
   for (int i = 0; i < n; ++i) rhs.row(free_to_dof_[i]) = cols.row(i);
 }
 
+void ImplicitSystem::HalfSolveColumns(const Eigen::Ref<const MatX>& rhs, MatX& z) const {
+  TAUT_DEMAND(supports_half_solve(), "ImplicitSystem: half solves need the SparseLdlt backend");
+  const int n = num_free_dofs();
+  z.resize(n, rhs.cols());
+  if (n == 0) return;
+  TAUT_ASSERT(factor_current_);
+  for (Eigen::Index c = 0; c < rhs.cols(); ++c)
+    for (int i = 0; i < n; ++i) z(i, c) = rhs(free_to_dof_[i], c);
+  ldlt_.HalfSolveColumns(z);
+}
+
+void ImplicitSystem::CompleteHalfSolve(const VecX& z, Eigen::Ref<VecX> out) const {
+  TAUT_DEMAND(supports_half_solve(), "ImplicitSystem: half solves need the SparseLdlt backend");
+  const int n = num_free_dofs();
+  out.setZero();
+  if (n == 0) return;
+  TAUT_ASSERT(factor_current_);
+  rhs_free_ = z;
+  ldlt_.CompleteHalfSolve(rhs_free_);
+  for (int i = 0; i < n; ++i) out[free_to_dof_[i]] = rhs_free_[i];
+}
+
 void ImplicitSystem::Multiply(const VecX& v, VecX& out) const { MultiplyWith(A_, v, out); }
 
 void ImplicitSystem::ResetNewtonMatrix() {

@@ -68,6 +68,13 @@ class ImplicitSystem {
   void Solve(Eigen::Ref<VecX> rhs) const;
   // Same for each column of rhs (3N x k).
   void SolveColumns(Eigen::Ref<MatX> rhs) const;
+  // The halves of A^-1 (SparseLdlt::HalfSolveColumns; the SparseLdlt backend only, see
+  // supports_half_solve): z (num_free x k) = D^-1/2 L^-1 P rhs on free DOFs for rhs (3N x k), so
+  // that rhs^T A^-1 rhs = z^T z; CompleteHalfSolve: out (3N) = A^-1 rhs c from z c (constrained
+  // DOFs 0). Require factor_is_current().
+  bool supports_half_solve() const { return !use_cholmod_; }
+  void HalfSolveColumns(const Eigen::Ref<const MatX>& rhs, MatX& z) const;
+  void CompleteHalfSolve(const VecX& z, Eigen::Ref<VecX> out) const;
   // rhs (3N) <- P^-1 rhs with the held factor P, this step's A or an earlier step's kept one: an
   // approximate A^-1 for starting guesses, which does not make the next step factor A (unlike
   // EnsureCurrentFactor). Factors A when no factor is held. Throws SimulationError like Factor.

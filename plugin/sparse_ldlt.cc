@@ -221,32 +221,46 @@ void SparseLdlt::SolveColumns(Eigen::Ref<MatX> B) const {
   for (; c < m; ++c) SolveBlock<1>(B.data() + c * stride, stride);
 }
 
-// x = P^T L^-T D^-1 L^-1 P b for kWidth columns at once, through the row-major workspace.
+// forward: L Z = X in the workspace, column by column of L; zero rows (sparse right-hand sides
+// such as columns of J^T) are skipped.
 template <int kWidth>
-void SparseLdlt::SolveBlock(double* b, Eigen::Index outer_stride) const {
-  static_assert(kWidth <= kMaxBlockColumns, "workspace holds kMaxBlockColumns columns");
+void SparseLdlt::SolveLowerBlock() const {
   using Row = Eigen::Matrix<double, kWidth, 1>;
   double* w = work_.data();
-  // Row k of the (n x kWidth) row-major block X.
   auto row = [w](int k) { return Eigen::Map<Row>(w + static_cast<size_t>(k) * kWidth); };
-  // gather: X = P B.
-  for (int k = 0; k < n_; ++k)
-    for (int c = 0; c < kWidth; ++c) w[k * kWidth + c] = b[perm_[k] + c * outer_stride];
-  // forward: L Z = X, column by column of L; zero rows (sparse right-hand sides such as columns
-  // of J^T) are skipped.
   for (int j = 0; j < n_; ++j) {
     const Row x_j = row(j);
     if ((x_j.array() == 0.0).all()) continue;
     for (int p = col_start_[j]; p < col_start_[j + 1]; ++p) row(l_row_[p]) -= l_val_[p] * x_j;
   }
-  // diagonal: Y = D^-1 Z.
-  for (int j = 0; j < n_; ++j) row(j) *= d_inv_[j];
-  // backward: L^T W = Y, row j of W = y_j - sum_i L(i, j) w_i over the stored column j.
+}
+
+// backward: L^T W = Y in the workspace, row j of W = y_j - sum_i L(i, j) w_i over column j.
+template <int kWidth>
+void SparseLdlt::SolveLowerTransposedBlock() const {
+  using Row = Eigen::Matrix<double, kWidth, 1>;
+  double* w = work_.data();
+  auto row = [w](int k) { return Eigen::Map<Row>(w + static_cast<size_t>(k) * kWidth); };
   for (int j = n_ - 1; j >= 0; --j) {
     Row s = row(j);
     for (int p = col_start_[j]; p < col_start_[j + 1]; ++p) s -= l_val_[p] * row(l_row_[p]);
     row(j) = s;
   }
+}
+
+// x = P^T L^-T D^-1 L^-1 P b for kWidth columns at once, through the row-major workspace.
+template <int kWidth>
+void SparseLdlt::SolveBlock(double* b, Eigen::Index outer_stride) const {
+  static_assert(kWidth <= kMaxBlockColumns, "workspace holds kMaxBlockColumns columns");
+  double* w = work_.data();
+  // gather: X = P B.
+  for (int k = 0; k < n_; ++k)
+    for (int c = 0; c < kWidth; ++c) w[k * kWidth + c] = b[perm_[k] + c * outer_stride];
+  SolveLowerBlock<kWidth>();
+  // diagonal: Y = D^-1 Z.
+  for (int k = 0; k < n_; ++k)
+    for (int c = 0; c < kWidth; ++c) w[k * kWidth + c] *= d_inv_[k];
+  SolveLowerTransposedBlock<kWidth>();
   // scatter: B = P^T W.
   for (int k = 0; k < n_; ++k)
     for (int c = 0; c < kWidth; ++c) b[perm_[k] + c * outer_stride] = w[k * kWidth + c];
@@ -261,6 +275,74 @@ void SparseLdlt::SolveSupernodal(double* b, Eigen::Index outer_stride, int width
   supernodal_factor_.Solve(w, width);
   for (int k = 0; k < n_; ++k)
     for (int c = 0; c < width; ++c) b[perm_[k] + c * outer_stride] = w[k * width + c];
+}
+
+// Z = D^-1/2 L^-1 P B by blocks of kMaxBlockColumns (the supernodal factor's L is the Cholesky
+// factor, D = I there), left in elimination order. The columns go through in the order of their
+// first nonzero in elimination order, so the columns of one block share most of their paths.
+void SparseLdlt::HalfSolveColumns(Eigen::Ref<MatX> B) const {
+  DemandReadyToSolve(B.rows());
+  TAUT_DEMAND(num_negative_pivots_ == 0, "SparseLdlt: half solve of an indefinite matrix (",
+              num_negative_pivots_, " negative pivots)");
+  const Eigen::Index stride = B.outerStride();
+  const int m = static_cast<int>(B.cols());
+  half_order_.resize(m);
+  for (int c = 0; c < m; ++c) {
+    int first = n_;
+    for (int i = 0; i < n_; ++i)
+      if (B(i, c) != 0.0) first = std::min(first, iperm_[i]);
+    half_order_[c] = {first, c};
+  }
+  std::sort(half_order_.begin(), half_order_.end());
+  double* w = work_.data();
+  for (int c0 = 0; c0 < m; c0 += kMaxBlockColumns) {
+    const int width = std::min(kMaxBlockColumns, m - c0);
+    // The scalar kernel runs at width 1, 4, 8 or 16 (unused columns zero); the supernodal one at
+    // `width`.
+    const int w_stride = supernodal_  ? width
+                         : width <= 1 ? 1
+                         : width <= 4 ? 4
+                         : width <= 8 ? 8
+                                      : kMaxBlockColumns;
+    auto column = [&](int c) { return B.data() + half_order_[c0 + c].second * stride; };
+    for (int c = 0; c < width; ++c) {
+      const double* b = column(c);
+      for (int k = 0; k < n_; ++k) w[k * w_stride + c] = b[perm_[k]];
+    }
+    for (int k = 0; k < n_; ++k)
+      for (int c = width; c < w_stride; ++c) w[k * w_stride + c] = 0.0;
+    if (supernodal_)
+      supernodal_factor_.SolveLower(w, width);
+    else if (w_stride == 1)
+      SolveLowerBlock<1>();
+    else if (w_stride == 4)
+      SolveLowerBlock<4>();
+    else if (w_stride == 8)
+      SolveLowerBlock<8>();
+    else
+      SolveLowerBlock<kMaxBlockColumns>();
+    for (int c = 0; c < width; ++c) {
+      double* b = column(c);
+      if (supernodal_)
+        for (int k = 0; k < n_; ++k) b[k] = w[k * w_stride + c];
+      else
+        for (int k = 0; k < n_; ++k) b[k] = w[k * w_stride + c] * std::sqrt(d_inv_[k]);
+    }
+  }
+}
+
+// x = P^T L^-T D^-1/2 z, the other half: CompleteHalfSolve(HalfSolve(b)) = A^-1 b.
+void SparseLdlt::CompleteHalfSolve(Eigen::Ref<VecX> z) const {
+  DemandReadyToSolve(z.size());
+  double* w = work_.data();
+  if (supernodal_) {
+    for (int k = 0; k < n_; ++k) w[k] = z[k];
+    supernodal_factor_.SolveLowerTransposed(w, 1);
+  } else {
+    for (int k = 0; k < n_; ++k) w[k] = z[k] * std::sqrt(d_inv_[k]);
+    SolveLowerTransposedBlock<1>();
+  }
+  for (int k = 0; k < n_; ++k) z[perm_[k]] = w[k];
 }
 
 double SparseLdlt::CalcFactorWork() const {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <Eigen/SparseCore>
+#include <utility>
 #include <vector>
 
 #include "plugin/common.h"
@@ -68,6 +69,15 @@ class SparseLdlt {
   // columns through each pass over L. No heap allocation. Same errors as Solve.
   void SolveColumns(Eigen::Ref<MatX> B) const;
 
+  // The halves of A^-1 for Delassus operators (docs/math.md §5.7): with A = P^T L D L^T P,
+  // B^T A^-1 B = Z^T Z for Z = D^-1/2 L^-1 P B. HalfSolveColumns: B := Z (rows in elimination
+  // order); the forward solve skips the rows where a block of B is zero, so a sparse column costs
+  // its elimination-tree path only. CompleteHalfSolve: z := P^T L^-T D^-1/2 z, so that
+  // CompleteHalfSolve(Z c) = A^-1 B c. Both need positive pivots (InputError otherwise) and
+  // allocate nothing; same errors as Solve.
+  void HalfSolveColumns(Eigen::Ref<MatX> B) const;
+  void CompleteHalfSolve(Eigen::Ref<VecX> z) const;
+
   // Number of rows (and columns) of A.
   int rows() const { return n_; }
   // Nonzeros of L strictly below the diagonal (the unit diagonal is not stored).
@@ -96,6 +106,11 @@ class SparseLdlt {
   // Solves for kWidth columns stored at b + c * outer_stride, c = 0..kWidth-1.
   template <int kWidth>
   void SolveBlock(double* b, Eigen::Index outer_stride) const;
+  // The workspace's rows (n x kWidth, row-major) through L^-1, and through L^-T.
+  template <int kWidth>
+  void SolveLowerBlock() const;
+  template <int kWidth>
+  void SolveLowerTransposedBlock() const;
   // Solves through the supernodal factor for `width` columns (gather P B, solve, scatter).
   void SolveSupernodal(double* b, Eigen::Index outer_stride, int width) const;
   // Throws InputError unless a factorization is ready for right-hand sides with `size` rows.
@@ -139,6 +154,8 @@ class SparseLdlt {
 
   // Solve workspace: (n x kMaxBlockColumns) row-major, so one row of a block is contiguous.
   mutable std::vector<double> work_;
+  // HalfSolveColumns: (first nonzero in elimination order, column) of each right-hand side.
+  mutable std::vector<std::pair<int, int>> half_order_;
 };
 
 }  // namespace taut

@@ -255,12 +255,15 @@ bool SupernodalCholesky::FactorPanel(int t) {
   return true;
 }
 
-// Forward L Z = Y then backward L^T X = Z, one supernode's dense blocks at a time.
-void SupernodalCholesky::Solve(double* y_data, int width_b) const {
+namespace {
+using SolveRowBlock =
+    Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>;
+}  // namespace
+
+// Forward L Z = Y, one supernode's dense blocks at a time.
+void SupernodalCholesky::SolveLower(double* y_data, int width_b) const {
   TAUT_ASSERT(width_b <= kMaxSolveColumns);
-  using RowBlock =
-      Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>;
-  RowBlock y(y_data, n_, width_b);
+  SolveRowBlock y(y_data, n_, width_b);
   const int num_sn = num_supernodes();
   for (int s = 0; s < num_sn; ++s) {
     const ConstPanel l_s = read_panel(s);
@@ -270,23 +273,35 @@ void SupernodalCholesky::Solve(double* y_data, int width_b) const {
     if ((y_s.array() == 0.0).all()) continue;
     l_s.topRows(w).triangularView<Eigen::Lower>().solveInPlace(y_s);
     if (below == 0) continue;
-    RowBlock t(solve_work_.data(), below, width_b);
+    SolveRowBlock t(solve_work_.data(), below, width_b);
     t.noalias() = l_s.bottomRows(below) * y_s;
     const int* rows_below = rows_.data() + row_start_[s] + w;
     for (int k = 0; k < below; ++k) y.row(rows_below[k]) -= t.row(k);
   }
-  for (int s = num_sn - 1; s >= 0; --s) {
+}
+
+// Backward L^T X = Z, supernodes in reverse order.
+void SupernodalCholesky::SolveLowerTransposed(double* y_data, int width_b) const {
+  TAUT_ASSERT(width_b <= kMaxSolveColumns);
+  SolveRowBlock y(y_data, n_, width_b);
+  for (int s = num_supernodes() - 1; s >= 0; --s) {
     const ConstPanel l_s = read_panel(s);
     const int w = width(s), below = rows_in(s) - w;
     auto y_s = y.middleRows(sn_start_[s], w);
     if (below > 0) {
-      RowBlock t(solve_work_.data(), below, width_b);
+      SolveRowBlock t(solve_work_.data(), below, width_b);
       const int* rows_below = rows_.data() + row_start_[s] + w;
       for (int k = 0; k < below; ++k) t.row(k) = y.row(rows_below[k]);
       y_s.noalias() -= l_s.bottomRows(below).transpose() * t;
     }
     l_s.topRows(w).triangularView<Eigen::Lower>().transpose().solveInPlace(y_s);
   }
+}
+
+// C^-1 = L^-T L^-1.
+void SupernodalCholesky::Solve(double* y_data, int width_b) const {
+  SolveLower(y_data, width_b);
+  SolveLowerTransposed(y_data, width_b);
 }
 
 void SupernodalCholesky::CalcPivots(std::vector<double>& d) const {

@@ -40,6 +40,10 @@ class SupernodalCholesky {
 
   // Solves C X = Y in place for a row-major (n x width) block Y (permuted order).
   void Solve(double* y, int width) const;
+  // Its halves: L Z = Y (rows of Y that are zero on a whole supernode are skipped, so sparse
+  // right-hand sides touch only their elimination-tree paths), then L^T X = Z.
+  void SolveLower(double* y, int width) const;
+  void SolveLowerTransposed(double* y, int width) const;
 
   // Pivots of the equivalent LDL^T: D_jj = L_jj^2 (valid after a successful Factorize).
   void CalcPivots(std::vector<double>& d) const;

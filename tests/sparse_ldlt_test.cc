@@ -185,6 +185,52 @@ TEST(SparseLdltTest, SolveColumnsEqualsColumnByColumnSolve) {
   EXPECT_EQ(X.bottomRows(3), big.bottomRows(3));
 }
 
+// B^T A^-1 B = Z^T Z for Z = HalfSolveColumns(B), and CompleteHalfSolve(Z c) = A^-1 B c, for
+// both kernels, sparse columns (as J^T has) and dense ones, every block width.
+TEST(SparseLdltTest, HalfSolvesComposeToTheInverse) {
+  const SparseMatrix A = testing::MakeRandomTetBlockSpd(3, 3, 3, 17);
+  const int n = static_cast<int>(A.rows());
+  const MatX A_inv = Eigen::LDLT<MatX>(MatX(A)).solve(MatX::Identity(n, n));
+  MatX B(n, 23);  // 16 + 4 + 3 columns
+  for (int c = 0; c < B.cols(); ++c) B.col(c) = MakeRandomVec(n, 300 + c);
+  for (int c : {0, 5, 16, 17, 20, 22}) {
+    B.col(c).setZero();
+    B.col(c).segment((11 * c) % (n - 3), 3).setConstant(1.0);
+  }
+  const MatX reference = B.transpose() * A_inv * B;
+  const VecX c_weights = MakeRandomVec(static_cast<int>(B.cols()), 7);
+  const VecX impulse = A_inv * (B * c_weights);
+  for (SparseLdlt::Kernel kernel :
+       {SparseLdlt::Kernel::kUpLooking, SparseLdlt::Kernel::kSupernodal}) {
+    SparseLdlt ldlt;
+    ldlt.Analyze(A, kernel);
+    ASSERT_TRUE(ldlt.Factorize(A));
+    for (int width : {1, 3, 4, 8, 23}) {
+      MatX Z = B.leftCols(width);
+      ldlt.HalfSolveColumns(Z);
+      const MatX ref = reference.topLeftCorner(width, width);
+      EXPECT_LT((Z.transpose() * Z - ref).norm(), 1e-12 * ref.norm())
+          << "supernodal " << ldlt.supernodal() << " width " << width;
+    }
+    MatX Z = B;
+    ldlt.HalfSolveColumns(Z);
+    VecX v = Z * c_weights;
+    ldlt.CompleteHalfSolve(v);
+    EXPECT_LT(CalcRelError(v, impulse), 1e-12) << "supernodal " << ldlt.supernodal();
+  }
+}
+
+TEST(SparseLdltTest, HalfSolveRejectsAnIndefiniteMatrix) {
+  SparseMatrix A = testing::MakeRandomTetBlockSpd(2, 2, 2, 21);
+  A.coeffRef(0, 0) -= 1e3;
+  SparseLdlt ldlt;
+  ldlt.Analyze(A, SparseLdlt::Kernel::kUpLooking);
+  ASSERT_TRUE(ldlt.Factorize(A));
+  ASSERT_GT(ldlt.num_negative_pivots(), 0);
+  MatX B = MatX::Identity(A.rows(), 2);
+  EXPECT_THROW(ldlt.HalfSolveColumns(B), InputError);
+}
+
 TEST(SparseLdltTest, CountsNegativePivotsOfIndefiniteMatrix) {
   // Random symmetric pattern with a diagonal of mixed sign: negative pivots = negative eigenvalues.
   for (unsigned seed = 20; seed < 25; ++seed) {
