@@ -19,6 +19,7 @@ class DeformableIslandBody final : public IslandBody {
     body_->SolveSystemColumns(columns);
   }
   bool supports_half_solve() const override { return body_->supports_half_solve(); }
+  bool HalfSolvesPay(int num_rows) const override { return body_->HalfSolvesPay(num_rows); }
   void HalfSolveSystemColumns(const Eigen::Ref<const MatX>& rhs, MatX& z) const override {
     body_->HalfSolveSystemColumns(rhs, z);
   }

@@ -43,6 +43,7 @@ void DelassusColumns::Clear() {
   for (BodyColumns& body : bodies_) {
     body.sources.clear();
     body.by_key.clear();
+    body.num_blocks = -1;  // the kind of columns is chosen again
   }
   columns_solved_ = 0;
   columns_kept_ = 0;
@@ -75,15 +76,16 @@ void DelassusColumns::Build(const std::vector<IslandBody*>& bodies, const Island
   for (size_t b = 0; b < bodies.size(); ++b) {
     BodyColumns& body = bodies_[b];
     const std::vector<int>& body_rows = rows.body_rows(static_cast<int>(b));
-    const bool half = bodies[b]->supports_half_solve();
-    if (half != body.half || body.num_blocks != bodies[b]->num_blocks()) {
-      // another body at this index: nothing to keep
-      body.half = half;
+    const int n_full = 3 * bodies[b]->num_blocks(), m = static_cast<int>(body_rows.size());
+    if (body.num_blocks != bodies[b]->num_blocks()) {
+      // The first Build of a step (or another body at this index): nothing to keep, and the
+      // kind of columns is chosen for the step by the body's cost rule.
+      body.half = bodies[b]->HalfSolvesPay(m);
       body.num_blocks = bodies[b]->num_blocks();
       body.sources.clear();
       body.by_key.clear();
     }
-    const int n_full = 3 * bodies[b]->num_blocks(), m = static_cast<int>(body_rows.size());
+    const bool half = body.half;
     const bool keep = !body.sources.empty();
     body.next_sources.resize(m);
     body.kept_from.assign(m, -1);

@@ -15,11 +15,13 @@ namespace taut {
 // Per island body, the solved columns of its rows and its Delassus block W_b = J_b A_b^-1 J_b^T
 // (docs/math.md §5.7: the SQP's W = sum_b W_b and v_QP = v* + sum_b A_b^-1 J_b^T lambda_b).
 // Two kinds of columns:
-//   - bodies with half solves (deformable bodies on SparseLdlt): Z_b = G_b J_b^T with
-//     A_b^-1 = G_b^T G_b, so W_b = Z_b^T Z_b and A_b^-1 J_b^T lambda = G_b^T (Z_b lambda). The
-//     forward solve of a sparse column only runs along its elimination-tree path, and the
-//     backward solve runs once per QP instead of once per row;
-//   - the others (rigid bodies, multibodies): Y_b = A_b^-1 J_b^T, W_b = J_b Y_b.
+//   - bodies where half solves pay (IslandBody::HalfSolvesPay, chosen at the first Build of a
+//     step: deformable bodies on SparseLdlt with few rows for the size of their factor):
+//     Z_b = G_b J_b^T with A_b^-1 = G_b^T G_b, so W_b = Z_b^T Z_b and A_b^-1 J_b^T lambda =
+//     G_b^T (Z_b lambda). The forward solve of a sparse column only runs along its
+//     elimination-tree path, and the backward solve runs once per QP instead of once per row;
+//   - the others (rigid bodies, multibodies, deformable bodies with many rows): Y_b = A_b^-1 J_b^T,
+//     W_b = J_b Y_b.
 // A is fixed within a step, so a row that comes back in the next SQP iteration with the same key
 // and the same J entries on the body (contact rows on a fixed normal, joint rows; not limit rows,
 // whose J moves with x) keeps its column, and its entries of W_b with the other kept rows; only
@@ -53,13 +55,13 @@ class DelassusColumns {
     bool operator==(const ColumnSource& o) const;
   };
   struct BodyColumns {
-    bool half = false;                                  // Y holds Z_b (half solves)
-    int num_blocks = -1;                                // the body's blocks at the last Build
-    MatX Y;                                             // columns of the current rows
-    MatX W;                                             // W_b of the current rows
-    MatX next_W;                                        // the next Build's W_b, swapped in
-    std::vector<int> kept_from;                         // column of the kept Y, -1 when solved
-    std::vector<ColumnSource> sources;                  // what each column of Y was solved for
+    bool half = false;                  // Y holds Z_b (half solves)
+    int num_blocks = -1;                // the body's blocks at the last Build; -1 after Clear
+    MatX Y;                             // columns of the current rows
+    MatX W;                             // W_b of the current rows
+    MatX next_W;                        // the next Build's W_b, swapped in
+    std::vector<int> kept_from;         // column of the kept Y, -1 when solved
+    std::vector<ColumnSource> sources;  // what each column of Y was solved for
     std::vector<std::pair<std::uint64_t, int>> by_key;  // (key, column), sorted by key
     MatX next;                                          // the next Build's Y, swapped in
     MatX fresh;                                         // right-hand sides of the columns to solve

@@ -32,6 +32,11 @@ class IslandBody {
   // with A^-1 = G^T G (deformable: G = D^-1/2 L^-1 P of A's sparse factor), so the Delassus block
   // J A^-1 J^T = (G J^T)^T (G J^T) and A^-1 J^T c = G^T (G J^T c). Default: not supported.
   virtual bool supports_half_solve() const { return false; }
+  // True when half solves are supported and cheaper than full ones for num_rows rows.
+  virtual bool HalfSolvesPay(int num_rows) const {
+    (void)num_rows;
+    return false;
+  }
   virtual void HalfSolveSystemColumns(const Eigen::Ref<const MatX>& rhs, MatX& z) const {
     (void)rhs;
     (void)z;

@@ -209,6 +209,11 @@ void ImplicitSystem::SolveColumns(Eigen::Ref<MatX> rhs) const {
   for (int i = 0; i < n; ++i) rhs.row(free_to_dof_[i]) = cols.row(i);
 }
 
+bool ImplicitSystem::HalfSolvesPay(int num_rows) const {
+  return supports_half_solve() &&
+         static_cast<double>(num_rows) * num_free_dofs() < 4.0 * ldlt_.nonzeros_in_L();
+}
+
 void ImplicitSystem::HalfSolveColumns(const Eigen::Ref<const MatX>& rhs, MatX& z) const {
   TAUT_DEMAND(supports_half_solve(), "ImplicitSystem: half solves need the SparseLdlt backend");
   const int n = num_free_dofs();

@@ -73,6 +73,13 @@ class ImplicitSystem {
   // that rhs^T A^-1 rhs = z^T z; CompleteHalfSolve: out (3N) = A^-1 rhs c from z c (constrained
   // DOFs 0). Require factor_is_current().
   bool supports_half_solve() const { return !use_cholmod_; }
+  // True when half solves are cheaper than full ones for a Delassus block of num_rows rows:
+  // a column's full solve adds the backward pass (2 nnz(L) multiply-adds), a half-solved column
+  // adds its products in W = Z^T Z (at most num_free num_rows / 2), so half solves pay while
+  // num_rows num_free < 4 nnz(L). Measured (taut-demo, Σ ms_solve): the armadillo's bodies (90
+  // contact rows, 2,361 free DOFs) 2,113 -> 1,323 ms with half solves; the gripper's finger pads
+  // (limit rows solved afresh in every SQP iteration) 1,436 -> 1,709 ms.
+  bool HalfSolvesPay(int num_rows) const;
   void HalfSolveColumns(const Eigen::Ref<const MatX>& rhs, MatX& z) const;
   void CompleteHalfSolve(const VecX& z, Eigen::Ref<VecX> out) const;
   // rhs (3N) <- P^-1 rhs with the held factor P, this step's A or an earlier step's kept one: an

@@ -121,6 +121,22 @@ TEST_F(DelassusColumnsTest, KeepsColumnsOfUnchangedRowsAndSolvesTheOthers) {
   ExpectDelassusOfRows(source);
 }
 
+TEST_F(DelassusColumnsTest, ManyRowsForTheFactorTakeFullColumnsWithTheSameDelassus) {
+  // Six rows per node, twice as many rows as DOFs: rows x DOFs exceed 4 nnz(L) (L has fewer than
+  // n^2 / 2 entries), so full columns Y = A^-1 J^T are cheaper than half solves.
+  ListedRows source;
+  std::uint64_t key = 100;
+  for (int node = 0; node < island_body_.num_blocks(); ++node)
+    for (const Vec3& J : {Vec3(Vec3::UnitX()), Vec3(Vec3::UnitY()), Vec3(Vec3::UnitZ()),
+                          Vec3(0.6, 0.8, 0.0), Vec3(0.0, 0.6, 0.8), Vec3(0.8, 0.0, 0.6)})
+      source.entries.push_back({key++, node, J});
+  ASSERT_FALSE(island_body_.HalfSolvesPay(static_cast<int>(source.entries.size())));
+  ASSERT_TRUE(island_body_.HalfSolvesPay(3));
+  Build(source);
+  EXPECT_FALSE(columns_.half_solved(0));
+  ExpectDelassusOfRows(source);
+}
+
 TEST_F(DelassusColumnsTest, ClearForgetsTheKeptColumns) {
   ListedRows source;
   source.entries = {{21, 3, Vec3::UnitZ()}};
