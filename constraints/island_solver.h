@@ -76,9 +76,17 @@ class IslandSolver {
     StepWindow primal{0, kPrimalStepsAfterDualFailure};  // primal path after a dual failure
     StepWindow dual{0, kDualStepsAfterPrimalFailure};    // dual path after a primal failure
     StepWindow no_retry{0, kStepsWithoutRetryAfterFailedRetry};  // no retries after a failed one
+    bool primal_refactor_next = false;  // PrimalSolver::refactor_next of the last primal solve
   };
-  State SaveState() const { return state_; }
-  void RestoreState(const State& state) { state_ = state; }
+  State SaveState() const {
+    State state = state_;
+    state.primal_refactor_next = primal_.refactor_next();
+    return state;
+  }
+  void RestoreState(const State& state) {
+    state_ = state;
+    primal_.set_refactor_next(state.primal_refactor_next);
+  }
 
   // The rows of the last Solve at its final velocities and their multipliers, one per row
   // (contact rows: impulses [N s]; limit rows [N m s]), from the path that ran. Reading them

@@ -736,7 +736,10 @@ void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
   model_steps_off_ = false;
   last_violation_.clear();
   kept_growth_.clear();
-  refactor_next_ = false;  // a factor kept from the previous step may precondition this one
+  // A factor kept from the previous step may precondition this one, unless its last PCG ran past
+  // the budget (refactor_next_ carried over): measured on rest_box (a rigid box on a soft block,
+  // a coupled island), a kept factor from the settling phase took 170 PCG iterations per step
+  // against 18 with a fresh one, step after step.
   const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
   CollectRowsAt(h, bodies, sources, start, settings, stats);
   stats.violation_before = violation_;

@@ -45,6 +45,12 @@ class PrimalSolver {
   // contact rows: impulses [N s]): lambda_bar, or the refitted multipliers that certified the
   // step (CalcKktResidualsWithRefit). Read-only: forces out.
   const IslandRows& rows() const { return rows_; }
+  // True when the last PCG with a kept factor ran past its budget: the next Newton matrix is
+  // factored afresh, also when that is in the next step (a coupled island's PCG is not capped by
+  // the budget, so a poor kept factor would otherwise cost every step; saved by world snapshots
+  // through IslandSolver::State).
+  bool refactor_next() const { return refactor_next_; }
+  void set_refactor_next(bool refactor) { refactor_next_ = refactor; }
   const VecX& multipliers() const { return reported_; }
 
  private:

@@ -368,6 +368,22 @@ BoxOnBlock RestBoxOnBlock(IslandSolverKind solver) {
   return result;
 }
 
+TEST(PrimalSolverTest, TheRefactorDecisionOfAnOverrunFactorIsPartOfTheSavedState) {
+  // A kept factor whose PCG ran past its budget is replaced at the next Newton matrix, also in the
+  // next step (rest_box on the auto path: 170 PCG iterations per step on a settling-phase factor
+  // against 18 with a fresh one, bench/island_solver_bench.cc). The decision outlives the step,
+  // so world snapshots carry it: a restored island factors when the saved one would have.
+  IslandSolver solver;
+  EXPECT_FALSE(solver.SaveState().primal_refactor_next);
+  IslandSolver::State state = solver.SaveState();
+  state.primal_refactor_next = true;
+  solver.RestoreState(state);
+  EXPECT_TRUE(solver.SaveState().primal_refactor_next);
+  state.primal_refactor_next = false;
+  solver.RestoreState(state);
+  EXPECT_FALSE(solver.SaveState().primal_refactor_next);
+}
+
 TEST(PrimalSolverTest, RigidBoxOnASoftBlockComesToRest) {
   // Two-way coupled island (PCG path): the box is carried by the block's contact rows and
   // settles; rest is rest (< 0.1 mm over the last second), every step converged.
