@@ -18,7 +18,6 @@ class DeformableIslandBody final : public IslandBody {
   void SolveSystemColumns(Eigen::Ref<MatX> columns) const override {
     body_->SolveSystemColumns(columns);
   }
-  bool supports_half_solve() const override { return body_->supports_half_solve(); }
   bool HalfSolvesPay(int num_rows) const override { return body_->HalfSolvesPay(num_rows); }
   void HalfSolveSystemColumns(const Eigen::Ref<const MatX>& rhs, MatX& z) const override {
     body_->HalfSolveSystemColumns(rhs, z);

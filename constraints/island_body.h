@@ -31,8 +31,8 @@ class IslandBody {
   // The halves of A^-1 for bodies with many blocks (docs/math.md §5.7): z = G rhs for a factor G
   // with A^-1 = G^T G (deformable: G = D^-1/2 L^-1 P of A's sparse factor), so the Delassus block
   // J A^-1 J^T = (G J^T)^T (G J^T) and A^-1 J^T c = G^T (G J^T c). Default: not supported.
-  virtual bool supports_half_solve() const { return false; }
-  // True when half solves are supported and cheaper than full ones for num_rows rows.
+  // HalfSolvesPay: true when the body has half solves and they are cheaper than full solves for
+  // num_rows rows; the other two are called only then.
   virtual bool HalfSolvesPay(int num_rows) const {
     (void)num_rows;
     return false;

@@ -113,8 +113,7 @@ class DeformableBody {
   void SolveSystemColumns(Eigen::Ref<MatX> rhs);
   // The halves of A^-1 (ImplicitSystem::HalfSolveColumns), factoring this step's A first like
   // SolveSystem: z = D^-1/2 L^-1 P rhs with rhs^T A^-1 rhs = z^T z, and out = A^-1 rhs c from
-  // z c. Only when supports_half_solve().
-  bool supports_half_solve() const { return system_.supports_half_solve(); }
+  // z c. Only on the SparseLdlt backend (HalfSolvesPay is false otherwise).
   bool HalfSolvesPay(int num_rows) const { return system_.HalfSolvesPay(num_rows); }
   void HalfSolveSystemColumns(const Eigen::Ref<const MatX>& rhs, MatX& z);
   void CompleteHalfSolve(const VecX& z, Eigen::Ref<VecX> out) const {

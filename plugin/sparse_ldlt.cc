@@ -321,12 +321,10 @@ void SparseLdlt::HalfSolveColumns(Eigen::Ref<MatX> B) const {
       SolveLowerBlock<8>();
     else
       SolveLowerBlock<kMaxBlockColumns>();
-    for (int c = 0; c < width; ++c) {
-      double* b = column(c);
-      if (supernodal_)
-        for (int k = 0; k < n_; ++k) b[k] = w[k * w_stride + c];
-      else
-        for (int k = 0; k < n_; ++k) b[k] = w[k * w_stride + c] * std::sqrt(d_inv_[k]);
+    // Z = D^-1/2 (L^-1 P B), one square root per row for the whole block.
+    for (int k = 0; k < n_; ++k) {
+      const double d_inv_sqrt = supernodal_ ? 1.0 : std::sqrt(d_inv_[k]);
+      for (int c = 0; c < width; ++c) column(c)[k] = w[k * w_stride + c] * d_inv_sqrt;
     }
   }
 }
