@@ -48,6 +48,9 @@ class DeformableIslandBody final : public IslandBody {
   }
   void FactorNewtonMatrix() override { body_->mutable_system().FactorNewtonMatrix(body_->name()); }
   void SolveNewton(Eigen::Ref<VecX> rhs) const override { body_->system().SolveNewton(rhs); }
+  void SolveNewtonColumns(Eigen::Ref<MatX> columns) const override {
+    body_->system().SolveNewtonColumns(columns);
+  }
   double CalcNewtonRefactorCost() const override {
     return body_->system().CalcNewtonRefactorCost();
   }

@@ -84,6 +84,10 @@ class IslandBody {
   virtual void FactorNewtonMatrix() = 0;
   // rhs <- H^-1 rhs (zero on blocks that do not move freely).
   virtual void SolveNewton(Eigen::Ref<VecX> rhs) const = 0;
+  // columns <- H^-1 columns (default: one SolveNewton per column).
+  virtual void SolveNewtonColumns(Eigen::Ref<MatX> columns) const {
+    for (Eigen::Index i = 0; i < columns.cols(); ++i) SolveNewton(columns.col(i));
+  }
   // out = H v (zero on blocks that do not move freely).
   virtual void ApplyNewtonMatrix(const VecX& v, VecX& out) const = 0;
   // The factor of an earlier H, if held, preconditions the Newton step instead of a new factor

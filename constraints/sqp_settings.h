@@ -87,6 +87,10 @@ struct SqpSettings {
   bool polish_active_set = true;   // refine an unconverged PGS answer by active-set solves
   ActiveSetPolishSettings polish;
   bool warm_start = true;  // warm-start lambda from the previous step by row key
+  // Dual path: each QP in the metric N = A + G, G the limit rows' curvature at (x_k, lambda_k)
+  // (constraints/curved_dual_metric.h): one more factorization per SQP iteration, for a
+  // faster-than-linear SQP; the answer it converges to is the same. Off: the papers' metric A.
+  bool dual_curvature = false;
   // Dual path: the SQP starts from v* + A^-1 J_0^T lambda_0, the warm multipliers on the rows at
   // the step's start positions, instead of v* (docs/math.md §5.7, warm-start velocity).
   // From there the SQP runs at least one QP and is certified only with distance rows (contacts,

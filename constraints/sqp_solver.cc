@@ -189,6 +189,8 @@ void SqpSolver::Iterate(double h, const std::vector<IslandBody*>& bodies,
       restoring = true;
     }
     const auto t_solve = std::chrono::steady_clock::now();
+    metric_on_ = !restoring && settings.dual_curvature &&
+                 metric_.Factor(h, bodies, sources, rows_, lambda_, v_k_);
     BuildQp(h, bodies, restoring);
     SolveQp(settings, stats);
     CalcQpVelocities(bodies, restoring);
@@ -272,18 +274,25 @@ double SqpSolver::CollectRowsAtIterate(double h, const std::vector<IslandBody*>&
 }
 
 void SqpSolver::BuildQp(double h, const std::vector<IslandBody*>& bodies, bool restoring) {
-  BuildDelassus(bodies);
-  // q = C(x_k)/h + J_k (v* - v_k).
+  if (metric_on_ && !restoring) {
+    metric_.CalcFreeVelocities(bodies, v_k_, v_free_);
+    metric_.BuildW(bodies, rows_, W_);
+  } else {
+    BuildDelassus(bodies);
+    v_free_.resize(bodies.size());
+    for (size_t b = 0; b < bodies.size(); ++b) v_free_[b] = bodies[b]->v_star();
+  }
+  // q = C(x_k)/h + J_k (v_free - v_k), v_free = v* in the papers' metric A.
   const int m = rows_.size();
   q_.resize(m);
   for (int c = 0; c < m; ++c) {
     const ConstraintRow& row = rows_[c];
     double jdv = 0.0;
     row.ForEachEntry([&](int body, int block, const Vec3& J) {
-      jdv += J.dot(bodies[body]->v_star().segment<3>(3 * block) - v_k_[body].segment<3>(3 * block));
+      jdv += J.dot(v_free_[body].segment<3>(3 * block) - v_k_[body].segment<3>(3 * block));
     });
     q_[c] = restoring ? row.C / h : row.C / h + jdv;
-    // Friction rows: w_t = J_t v = J_t (v* + Y lambda), so q = J_t v* (restoration: 0).
+    // Friction rows: w_t = J_t v = J_t (v_free + Y lambda), so q = J_t v_free (restoration: 0).
     if (row.friction_of > 0) q_[c] = restoring ? 0.0 : jdv + rows_.CalcRowVelocity(c, v_k_);
   }
   rows_.CalcPgsRows(pgs_rows_);
@@ -308,8 +317,14 @@ void SqpSolver::SolveQp(const SqpSettings& settings, StepStats& stats) {
   }
 }
 
-// v_QP = v* + A^-1 J^T lambda_QP (restoration: v_k + A^-1 J^T dlambda).
+// v_QP = v* + A^-1 J^T lambda_QP (restoration: v_k + A^-1 J^T dlambda; curved metric:
+// v_free + N^-1 J^T lambda_QP).
 void SqpSolver::CalcQpVelocities(const std::vector<IslandBody*>& bodies, bool restoring) {
+  if (metric_on_ && !restoring) {
+    v_qp_ = v_free_;
+    metric_.AddImpulseVelocities(rows_, lambda_qp_, v_qp_);
+    return;
+  }
   for (size_t b = 0; b < bodies.size(); ++b) {
     v_qp_[b] = restoring ? v_k_[b] : bodies[b]->v_star();
     columns_.AddImpulseVelocity(static_cast<int>(b), *bodies[b],

@@ -7,6 +7,7 @@
 
 #include "constraints/active_set_polish.h"
 #include "constraints/constraint_row.h"
+#include "constraints/curved_dual_metric.h"
 #include "constraints/delassus_columns.h"
 #include "constraints/island_body.h"
 #include "constraints/island_rows.h"
@@ -141,6 +142,10 @@ class SqpSolver {
   bool stalled_infeasible_ = false;  // see stalled_infeasible()
   KeyedMultipliers iterate_;         // this step's lambda_k by key
   bool warm_started_ = false;        // this Iterate starts from the warm-start velocity
+  // SqpSettings::dual_curvature: the QP of this iteration in the metric N = A + G.
+  CurvedDualMetric metric_;
+  bool metric_on_ = false;
+  std::vector<VecX> v_free_;  // the QP's free velocity: v*, or v_k - N^-1 A (v_k - v*)
 };
 
 }  // namespace taut

@@ -41,6 +41,12 @@ int& SqpIterationCap() {
   return cap;
 }
 
+// --dual-curvature: the dual path's QPs in the metric A + G (SqpSettings::dual_curvature).
+bool& DualCurvature() {
+  static bool on = false;
+  return on;
+}
+
 // Runs the scene and writes its outputs; returns the process exit code.
 int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::string& out_dir,
              bool vtk, int vtk_every, bool png) {
@@ -50,6 +56,7 @@ int RunScene(const taut::SceneInfo& info, int steps, double dt, const std::strin
   if (SolverChoice() != taut::IslandSolverKind::kAuto)
     scene->mutable_solver_settings().solver = SolverChoice();
   if (SqpIterationCap() > 0) scene->mutable_solver_settings().max_iterations = SqpIterationCap();
+  if (DualCurvature()) scene->mutable_solver_settings().dual_curvature = true;
   scene->SetThreadCount(ThreadCount());
   std::ofstream csv(out_dir + "/steps.csv");
   csv.precision(17);
@@ -183,6 +190,9 @@ int main(int argc, char** argv) {
   app.add_option("--sqp-iterations", SqpIterationCap(),
                  "SQP iteration cap of the dual path, >= 1 (default: the scene's, usually 10)")
       ->check(CLI::PositiveNumber);
+  app.add_flag("--dual-curvature", DualCurvature(),
+               "Dual path: each QP in the metric A + G, G the limit rows' curvature (default: the "
+               "papers' metric A)");
   app.add_option("--threads", ThreadCount(),
                  "Threads stepping the bodies and independent islands, >= 1 (default 1; results "
                  "are the same for any count)")

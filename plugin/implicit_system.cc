@@ -194,6 +194,12 @@ void ImplicitSystem::SolveApproximately(Eigen::Ref<VecX> rhs, const std::string&
 }
 
 void ImplicitSystem::SolveColumns(Eigen::Ref<MatX> rhs) const {
+  TAUT_ASSERT(factor_current_ || num_free_dofs() == 0);
+  SolveColumnsWith(ldlt_, cholmod_, rhs);
+}
+
+void ImplicitSystem::SolveColumnsWith(const SparseLdlt& ldlt, const CholmodCholesky& cholmod,
+                                      Eigen::Ref<MatX> rhs) const {
   const int n = num_free_dofs();
   if (columns_free_.rows() != n || columns_free_.cols() < rhs.cols())
     columns_free_.resize(n, std::max<Eigen::Index>(rhs.cols(), columns_free_.cols()));
@@ -201,11 +207,10 @@ void ImplicitSystem::SolveColumns(Eigen::Ref<MatX> rhs) const {
   for (int i = 0; i < n; ++i) cols.row(i) = rhs.row(free_to_dof_[i]);
   rhs.setZero();
   if (n == 0) return;
-  TAUT_ASSERT(factor_current_);
   if (use_cholmod_)
-    cholmod_.SolveColumns(cols);
+    cholmod.SolveColumns(cols);
   else
-    ldlt_.SolveColumns(cols);
+    ldlt.SolveColumns(cols);
   for (int i = 0; i < n; ++i) rhs.row(free_to_dof_[i]) = cols.row(i);
 }
 
@@ -299,6 +304,10 @@ void ImplicitSystem::FactorNewtonMatrix(const std::string& body) {
 
 void ImplicitSystem::SolveNewton(Eigen::Ref<VecX> rhs) const {
   SolveWith(newton_ldlt_, newton_cholmod_, rhs);
+}
+
+void ImplicitSystem::SolveNewtonColumns(Eigen::Ref<MatX> rhs) const {
+  SolveColumnsWith(newton_ldlt_, newton_cholmod_, rhs);
 }
 
 void ImplicitSystem::MultiplyNewton(const VecX& v, VecX& out) const { MultiplyWith(H_, v, out); }

@@ -114,6 +114,8 @@ class ImplicitSystem {
   void FactorNewtonMatrix(const std::string& body);
   // rhs (3N) <- H^-1 rhs on free DOFs; constrained DOFs set to 0.
   void SolveNewton(Eigen::Ref<VecX> rhs) const;
+  // rhs <- H^-1 rhs, column by column in blocks (SparseLdlt::SolveColumns).
+  void SolveNewtonColumns(Eigen::Ref<MatX> rhs) const;
   // out (3N) = H v on free DOFs, 0 on constrained DOFs.
   void MultiplyNewton(const VecX& v, VecX& out) const;
   // True when a factor of some earlier H (this pattern) is held: usable as a preconditioner.
@@ -168,6 +170,9 @@ class ImplicitSystem {
   // rhs (3N) <- M^-1 rhs on free DOFs with a factor of FactorWith; constrained DOFs set to 0.
   void SolveWith(const SparseLdlt& ldlt, const CholmodCholesky& cholmod,
                  Eigen::Ref<VecX> rhs) const;
+  // The same for the columns of rhs (3N x k).
+  void SolveColumnsWith(const SparseLdlt& ldlt, const CholmodCholesky& cholmod,
+                        Eigen::Ref<MatX> rhs) const;
   // out (3N) = M v on free DOFs, 0 on constrained DOFs.
   void MultiplyWith(const Eigen::SparseMatrix<double>& M, const VecX& v, VecX& out) const;
   // Value index of the first of the three rows of node a in column (free DOF) col, or -1.
