@@ -172,16 +172,19 @@ double RigidZ(const Setup& s) {
 }
 
 // Warm-up outside the timed loop, then one stepSimulation per iteration; counters as above.
-void RunCase(benchmark::State& state, const Case& c, bool constrained, IslandSolverKind kind) {
+void RunCase(benchmark::State& state, const Case& c, bool constrained, IslandSolverKind kind,
+             bool dual_curvature) {
   // The warmed-up world of the last (case, path), kept for its next repetition.
   static std::string cached_key;
   static std::unique_ptr<Setup> cached;
-  const std::string key = c.name + (constrained ? "/" : "/none/") + GetIslandSolverName(kind);
+  const std::string key = c.name + (constrained ? "/" : "/none/") + GetIslandSolverName(kind) +
+                          (dual_curvature ? "_curved" : "");
   if (!c.continue_repetitions || key != cached_key || !cached) {
     cached.reset();
     cached = std::make_unique<Setup>(c.make(constrained));
     cached_key = key;
     cached->world().mutable_solver_settings().solver = kind;
+    cached->world().mutable_solver_settings().dual_curvature = dual_curvature;
     for (int i = 0; i < c.warmup_steps; ++i) cached->world().stepSimulation(kDt, 1, kDt);
   }
   Setup& s = *cached;
@@ -258,23 +261,27 @@ std::vector<Case> MakeCases() {
   return cases;
 }
 
-// BM_IslandSolver/<case>/<solver>, solver in none (the unconstrained twin), dual, primal, auto.
+// BM_IslandSolver/<case>/<solver>, solver in none (the unconstrained twin), dual, dual_curved
+// (the dual path with SqpSettings::dual_curvature), primal, auto.
 const bool kRegistered = [] {
   static const std::vector<Case> cases = MakeCases();
   struct Path {
     const char* name;
     bool constrained;
     IslandSolverKind kind;
+    bool dual_curvature;
   };
-  const Path paths[] = {{"none", false, IslandSolverKind::kAuto},
-                        {"dual", true, IslandSolverKind::kDual},
-                        {"primal", true, IslandSolverKind::kPrimal},
-                        {"auto", true, IslandSolverKind::kAuto}};
+  const Path paths[] = {{"none", false, IslandSolverKind::kAuto, false},
+                        {"dual", true, IslandSolverKind::kDual, false},
+                        {"dual_curved", true, IslandSolverKind::kDual, true},
+                        {"primal", true, IslandSolverKind::kPrimal, false},
+                        {"auto", true, IslandSolverKind::kAuto, false}};
   for (const Case& c : cases)
     for (const Path& p : paths)
-      benchmark::RegisterBenchmark(
-          ("BM_IslandSolver/" + c.name + "/" + p.name).c_str(),
-          [&c, p](benchmark::State& state) { RunCase(state, c, p.constrained, p.kind); })
+      benchmark::RegisterBenchmark(("BM_IslandSolver/" + c.name + "/" + p.name).c_str(),
+                                   [&c, p](benchmark::State& state) {
+                                     RunCase(state, c, p.constrained, p.kind, p.dual_curvature);
+                                   })
           ->Iterations(c.timed_steps)
           ->Repetitions(c.repetitions)
           ->ReportAggregatesOnly(true)

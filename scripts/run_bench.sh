@@ -213,12 +213,14 @@ if island:
             "- SQP / Newton: mean iterations per step; unconverged: steps with "
             "`StepStats::converged` false, of the timed steps; max viol.: max `violation_after` "
             "(C units); primal: share of islands the primal path solved.",
+            "- path dual_curved: the dual path with its QPs in the metric A + G "
+            "(`SqpSettings::dual_curvature`, docs/math.md §5.7).",
             "- slab_roll sanity: sphere dx is the distance it rolled in the timed steps of one "
             "repetition, z its centre height at the end (0.18 m on the undeformed slab).", "",
             "| case | elements | path | ms/step | twin ms/step | ratio | in-step ratio | "
             "SQP | Newton | PGS sweeps | rows | unconverged | max viol. | primal | target |",
             "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|"]
-    order = {"none": 0, "dual": 1, "primal": 2, "auto": 3}
+    order = {"none": 0, "dual": 1, "dual_curved": 2, "primal": 3, "auto": 4}
     cases = ["tet_iso", "tet_aniso", "hex_0.1J", "slab_rest", "slab_roll", "rest_box"]
     def case_key(nb):
         case, path = split(nb[0])
@@ -275,7 +277,7 @@ if island:
         for base, paths in grow.items():
             t = paths.get("none", [])
             p_twin = fit([(x, y) for x, y, _ in t]) if len(t) >= 2 else float("nan")
-            for path in ("dual", "primal", "auto"):
+            for path in ("dual", "dual_curved", "primal", "auto"):
                 pts = paths.get(path, [])
                 if len(pts) < 2:
                     continue
