@@ -2,6 +2,25 @@
 
 namespace taut {
 
+void CurvatureMetric::CollectLimitRows(double h, const std::vector<IslandBody*>& bodies,
+                                       const std::vector<ConstraintSource*>& sources,
+                                       const IslandRows& rows, const VecX& lambda,
+                                       const std::vector<VecX>& v) {
+  Clear();
+  const int m = rows.size();
+  weights_.setZero(m);
+  bool any = false;
+  for (int c = 0; c < m; ++c) {
+    if (!IsLimitRow(rows[c]) || lambda[c] <= 0.0) continue;
+    weights_[c] = h * lambda[c];  // d^2/dv^2 of -lambda C(x0 + h v)/h: h lambda [-d^2 C/dx^2]
+    any = true;
+  }
+  if (!any) return;
+  const IslandIterate iterate(h, bodies, v, rows.positions());
+  for (const ConstraintSource* source : sources)
+    source->AddIslandCurvature(iterate, rows.rows().data(), weights_.data(), m, *this);
+}
+
 void CurvatureMetric::AddBlock(int body, int node_a, int node_b, const Mat3& block) {
   node_blocks_.push_back({body, node_a, node_b, block});
 }

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "constraints/constraint_row.h"
+#include "constraints/island_rows.h"
 
 namespace taut {
 
@@ -16,6 +17,11 @@ class CurvatureMetric final : public CurvatureSink {
   void AddElementBlock(int body, int element, const int* nodes,
                        const Eigen::Ref<const MatX>& block) override;
 
+  // Stage: G = h sum_c lambda_c [-d^2 C_c/dx^2]_+ over the limit rows with lambda_c > 0, from the
+  // sources, at the rows (collected at velocities v); replaces what was held.
+  void CollectLimitRows(double h, const std::vector<IslandBody*>& bodies,
+                        const std::vector<ConstraintSource*>& sources, const IslandRows& rows,
+                        const VecX& lambda, const std::vector<VecX>& v);
   void Clear();
   bool empty() const { return node_blocks_.empty() && elements_.empty(); }
   // out_b += G_b u_b for every body b.
@@ -39,6 +45,7 @@ class CurvatureMetric final : public CurvatureSink {
   std::vector<NodeBlock> node_blocks_;
   std::vector<ElementBlock> elements_;
   std::vector<double> values_;
+  VecX weights_;  // h lambda_c of the rows, for the sources (reused across calls)
 };
 
 }  // namespace taut

@@ -7,19 +7,7 @@ namespace taut {
 bool CurvedDualMetric::Factor(double h, const std::vector<IslandBody*>& bodies,
                               const std::vector<ConstraintSource*>& sources, const IslandRows& rows,
                               const VecX& lambda, const std::vector<VecX>& v) {
-  curvature_.Clear();
-  const int m = rows.size();
-  weights_.setZero(m);
-  bool any = false;
-  for (int c = 0; c < m && c < lambda.size(); ++c) {
-    if (!IsLimitRow(rows[c]) || lambda[c] <= 0.0) continue;
-    weights_[c] = h * lambda[c];  // d^2/dv^2 of -lambda C(x0 + h v)/h: h lambda [-d^2 C/dx^2]
-    any = true;
-  }
-  if (!any) return false;
-  const IslandIterate iterate(h, bodies, v, rows.positions());
-  for (const ConstraintSource* source : sources)
-    source->AddIslandCurvature(iterate, rows.rows().data(), weights_.data(), m, curvature_);
+  curvature_.CollectLimitRows(h, bodies, sources, rows, lambda, v);
   if (curvature_.empty()) return false;
   for (IslandBody* body : bodies) body->ResetNewtonMatrix();
   curvature_.AddToNewtonMatrices(bodies);
@@ -35,7 +23,8 @@ void CurvedDualMetric::CalcFreeVelocities(const std::vector<IslandBody*>& bodies
                                           const std::vector<VecX>& v, std::vector<VecX>& v_free) {
   v_free.resize(bodies.size());
   for (size_t b = 0; b < bodies.size(); ++b) {
-    bodies[b]->ApplySystemMatrix(v[b] - bodies[b]->v_star(), scratch_);
+    v_free[b] = v[b] - bodies[b]->v_star();
+    bodies[b]->ApplySystemMatrix(v_free[b], scratch_);
     bodies[b]->SolveNewton(scratch_);
     v_free[b] = v[b] - scratch_;
   }

@@ -38,7 +38,7 @@ class CurvedDualMetric {
 
  private:
   CurvatureMetric curvature_;
-  VecX weights_, scratch_;
+  VecX scratch_;
   std::vector<MatX> columns_;  // Y_b, 3 N_b x (rows of body b)
 };
 

@@ -159,20 +159,7 @@ void PrimalSolver::LinearizeRows(double h, const std::vector<IslandBody*>& bodie
 
 void PrimalSolver::CollectCurvature(double h, const std::vector<IslandBody*>& bodies,
                                     const std::vector<ConstraintSource*>& sources) {
-  curvature_.Clear();
-  VecX& weights = curvature_weights_;  // reused across iterations
-  weights.setZero(rows_.size());
-  bool any = false;
-  for (int c = 0; c < rows_.size(); ++c) {
-    if (!IsLimitRow(rows_[c]) || lambda_[c] <= 0.0) continue;
-    weights[c] = h * lambda_[c];  // d^2 Phi/dv^2 of -lambda g: h lambda [-d^2 C/dx^2]
-    any = true;
-  }
-  if (!any) return;
-  const IslandIterate iterate(h, bodies, v_, rows_.positions());
-  for (const ConstraintSource* source : sources)
-    source->AddIslandCurvature(iterate, rows_.rows().data(), weights.data(), rows_.size(),
-                               curvature_);
+  curvature_.CollectLimitRows(h, bodies, sources, rows_, lambda_, v_);
 }
 
 void PrimalSolver::CalcProjectedMultipliers() {

@@ -164,7 +164,6 @@ class PrimalSolver {
   bool model_steps_off_ = false;  // a model step fell short of its model in this step (solve)
   double line_a0_ = 0.0, line_dAd_ = 0.0;  // d^T A (v - v*) and d^T A d of the model line search
   CurvatureMetric curvature_;
-  VecX curvature_weights_;  // h lambda_c of the rows, for the sources' curvature
   // Consecutive rows on the same nodes of one body (one element's rows): their summed
   // rho D J^T J as one dense block, scattered into the Newton matrix once.
   struct RowGroup {

@@ -274,13 +274,12 @@ double SqpSolver::CollectRowsAtIterate(double h, const std::vector<IslandBody*>&
 }
 
 void SqpSolver::BuildQp(double h, const std::vector<IslandBody*>& bodies, bool restoring) {
-  if (metric_on_ && !restoring) {
+  // metric_on_ only outside restoration (Iterate).
+  if (metric_on_) {
     metric_.CalcFreeVelocities(bodies, v_k_, v_free_);
     metric_.BuildW(bodies, rows_, W_);
   } else {
     BuildDelassus(bodies);
-    v_free_.resize(bodies.size());
-    for (size_t b = 0; b < bodies.size(); ++b) v_free_[b] = bodies[b]->v_star();
   }
   // q = C(x_k)/h + J_k (v_free - v_k), v_free = v* in the papers' metric A.
   const int m = rows_.size();
@@ -289,7 +288,8 @@ void SqpSolver::BuildQp(double h, const std::vector<IslandBody*>& bodies, bool r
     const ConstraintRow& row = rows_[c];
     double jdv = 0.0;
     row.ForEachEntry([&](int body, int block, const Vec3& J) {
-      jdv += J.dot(v_free_[body].segment<3>(3 * block) - v_k_[body].segment<3>(3 * block));
+      const VecX& v_free = metric_on_ ? v_free_[body] : bodies[body]->v_star();
+      jdv += J.dot(v_free.segment<3>(3 * block) - v_k_[body].segment<3>(3 * block));
     });
     q_[c] = restoring ? row.C / h : row.C / h + jdv;
     // Friction rows: w_t = J_t v = J_t (v_free + Y lambda), so q = J_t v_free (restoration: 0).
@@ -320,7 +320,7 @@ void SqpSolver::SolveQp(const SqpSettings& settings, StepStats& stats) {
 // v_QP = v* + A^-1 J^T lambda_QP (restoration: v_k + A^-1 J^T dlambda; curved metric:
 // v_free + N^-1 J^T lambda_QP).
 void SqpSolver::CalcQpVelocities(const std::vector<IslandBody*>& bodies, bool restoring) {
-  if (metric_on_ && !restoring) {
+  if (metric_on_) {
     v_qp_ = v_free_;
     metric_.AddImpulseVelocities(rows_, lambda_qp_, v_qp_);
     return;
