@@ -4,12 +4,15 @@
 // data/armadillo.off is present (scripts/fetch_armadillo.sh), the armadillo scene's 368-hex
 // lattice. Backends, each its own benchmark BM_Factorization/<op>/<case>/<backend> (manual time,
 // median of the repetitions in the Time column):
-//   ldlt        SparseLdlt (taut's up-looking LDL^T, AMD ordering): the default build's backend
+//   ldlt        SparseLdlt (taut's LDL^T, its ordering chosen: AMD, or nested dissection for large
+//               bodies where it fills less): the default build's backend
+//   ldlt_amd    SparseLdlt with AMD forced (the ordering before nested dissection, for the ratio)
 //   eigen_llt   Eigen's SimplicialLLT (AMD ordering)
 //   cholmod     CHOLMOD's supernodal LL^T (only in builds with -DTAUT_WITH_CHOLMOD=ON, GPL-2+)
 // op: factor_solve (numeric factorization + one solve, what every step does) or solve64 (64
-// right-hand sides, the A^-1 J^T columns). Counters: dofs, elements, nnz_L (entries of L), and
-// rel_diff, the relative difference of the solution to ldlt's.
+// right-hand sides, the A^-1 J^T columns). Counters: dofs, elements, nnz_L (entries of L),
+// rel_diff, the relative difference of the solution to ldlt's, and (SparseLdlt) nested_dissection,
+// 1 when its ordering is nested dissection.
 //   taut_bench --benchmark_filter=BM_Factorization
 #include <benchmark/benchmark.h>
 
@@ -172,6 +175,19 @@ class EigenLlt {
   Eigen::SimplicialLLT<SparseMatrix, Eigen::Upper> llt_;
 };
 
+// SparseLdlt with the AMD ordering forced.
+class AmdLdlt : public SparseLdlt {
+ public:
+  void Analyze(const SparseMatrix& A) { SparseLdlt::Analyze(A, Kernel::kAuto, Ordering::kAmd); }
+};
+
+// 1 when the backend ordered by nested dissection (SparseLdlt), else 0.
+double UsesNestedDissection(const SparseLdlt& s) {
+  return s.ordering() == SparseLdlt::Ordering::kNestedDissection ? 1.0 : 0.0;
+}
+double UsesNestedDissection(const CholmodCholesky&) { return 0.0; }
+double UsesNestedDissection(const EigenLlt&) { return 0.0; }
+
 // Entries of L of each backend (CHOLMOD: stored supernodal entries).
 double EntriesOfL(const SparseLdlt& s) { return s.nonzeros_in_L(); }
 double EntriesOfL(const CholmodCholesky& s) { return s.stored_entries_in_L(); }
@@ -212,15 +228,21 @@ void RunBackend(benchmark::State& state, Solver& solver, Op op, const CaseSpec& 
   state.counters["elements"] = c.elements;
   state.counters["nnz_L"] = EntriesOfL(solver);
   state.counters["rel_diff"] = diff;
+  state.counters["nested_dissection"] = UsesNestedDissection(solver);
 }
 
 // The backends.
-enum class Backend { kLdlt, kEigenLlt, kCholmod };
+enum class Backend { kLdlt, kLdltAmd, kEigenLlt, kCholmod };
 
 void BM_Factor(benchmark::State& state, Op op, CaseSpec spec, Backend backend) {
   switch (backend) {
     case Backend::kLdlt: {
       SparseLdlt s;
+      RunBackend(state, s, op, spec);
+      break;
+    }
+    case Backend::kLdltAmd: {
+      AmdLdlt s;
       RunBackend(state, s, op, spec);
       break;
     }
@@ -256,8 +278,8 @@ const bool kRegistered = [] {
   };
   if (std::filesystem::exists(ArmadilloPath()))
     cases.push_back({"armadillo", {false, 0, 0, 0, true}});
-  std::vector<std::pair<Backend, const char*>> backends = {{Backend::kLdlt, "ldlt"},
-                                                           {Backend::kEigenLlt, "eigen_llt"}};
+  std::vector<std::pair<Backend, const char*>> backends = {
+      {Backend::kLdlt, "ldlt"}, {Backend::kLdltAmd, "ldlt_amd"}, {Backend::kEigenLlt, "eigen_llt"}};
   if (IsCholmodAvailable()) backends.push_back({Backend::kCholmod, "cholmod"});
   for (const auto& [op, op_name] :
        {std::pair{Op::kFactorSolve, "factor_solve"}, std::pair{Op::kSolve64, "solve64"}})

@@ -7,6 +7,17 @@ if(TAUT_BULLET_FLOAT)
 else()
   pkg_check_modules(BULLET REQUIRED IMPORTED_TARGET bullet-float64)
 endif()
+# METIS (Apache-2.0, Debian libmetis-dev): the nested-dissection ordering of large bodies
+# factorizations (plugin/nested_dissection.h). Debian ships no CMake or pkg-config file for it, so
+# METIS::METIS is made from the header and the library; tautConfig.cmake.in repeats this.
+if(NOT TARGET METIS::METIS)
+  find_path(METIS_INCLUDE_DIR metis.h REQUIRED)
+  find_library(METIS_LIBRARY metis REQUIRED)
+  add_library(METIS::METIS UNKNOWN IMPORTED)
+  set_target_properties(METIS::METIS PROPERTIES
+    IMPORTED_LOCATION ${METIS_LIBRARY}
+    INTERFACE_INCLUDE_DIRECTORIES ${METIS_INCLUDE_DIR})
+endif()
 # CHOLMOD (SuiteSparse), only with -DTAUT_WITH_CHOLMOD=ON: the supernodal Cholesky of large bodies
 # (plugin/cholmod_cholesky.h). Its supernodal module is GPL-2+, so a build with it is GPL-bound;
 # the default build neither finds nor links it (README "License").

@@ -11,7 +11,8 @@
 namespace taut {
 
 // Sparse P A P^T = L D L^T of a symmetric matrix A (L unit lower triangular, D diagonal, P a
-// fill-reducing AMD permutation), for A = M + h D + h^2 K of the implicit step (docs/math.md §5.1;
+// fill-reducing permutation: AMD, or nested dissection for large bodies), for A = M + h D + h^2 K
+// of the implicit step (docs/math.md §5.1;
 // docs/architecture.md §3, stage 2). The pattern of A is fixed per body while its values change
 // every step, so the work is split into a symbolic phase (Analyze, once per body: ordering,
 // elimination tree, column counts, every buffer) and a numeric phase (Factorize, every step) plus
@@ -43,16 +44,25 @@ class SparseLdlt {
   enum class Kernel { kAuto, kUpLooking, kSupernodal };
   // Factorization work (CalcFactorWork) from which kAuto picks the supernodal kernel.
   static constexpr double kSupernodalMinWork = 2e6;
+  // Fill-reducing ordering: chosen (kAuto: AMD, and where AMD's factor work is at least
+  // kNestedDissectionMinWork, about 5k-tet bodies, nested dissection instead when its factor has
+  // less work and no more nonzeros), or forced.
+  enum class Ordering { kAuto, kAmd, kNestedDissection };
+  static constexpr double kNestedDissectionMinWork = 3e7;
 
   // Largest number of right-hand sides SolveColumns carries through one pass over L.
   static constexpr int kMaxBlockColumns = 16;
 
-  // Symbolic phase: AMD ordering of the symmetric pattern, elimination tree, column counts of L,
+  // Symbolic phase: the ordering of the symmetric pattern (AMD; nested dissection instead where it
+  // gives the smaller factor, see Ordering), elimination tree, column counts of L,
   // the map from A's values to the permuted upper triangle, and every workspace. Values are
   // ignored. Throws InputError for a non-square, empty or uncompressed matrix.
-  void Analyze(const SparseMatrix& pattern, Kernel kernel = Kernel::kAuto);
+  void Analyze(const SparseMatrix& pattern, Kernel kernel = Kernel::kAuto,
+               Ordering ordering = Ordering::kAuto);
   // True when Analyze chose (or was given) the supernodal kernel.
   bool supernodal() const { return supernodal_; }
+  // The ordering Analyze chose (kAmd or kNestedDissection).
+  Ordering ordering() const { return ordering_; }
 
   // Numeric phase on a matrix with the analysed pattern (same outer index and nonzero count; the
   // row indices are compared in debug builds). No heap allocation (the supernodal kernel's dense
@@ -99,6 +109,12 @@ class SparseLdlt {
   const std::vector<double>& pivots() const { return d_; }
 
  private:
+  // perm_ = order (new -> old), then C and the elimination tree for it.
+  void AnalyzeOrdering(const SparseMatrix& pattern, const std::vector<int>& order);
+  // Analyzes the nested-dissection ordering and keeps it when `forced` or when its factor is
+  // smaller than AMD's (analyzed on entry), else analyzes `amd_order` again.
+  void ChooseNestedDissection(const SparseMatrix& pattern, const std::vector<int>& amd_order,
+                              bool forced);
   // Builds the permuted upper triangle C = triu(P A P^T) as structure plus a map into A's values.
   void BuildPermutedUpper(const SparseMatrix& pattern);
   // Elimination tree of C and the nonzero count of every column of L (Davis' LDL symbolic).
@@ -122,6 +138,7 @@ class SparseLdlt {
   int failed_column_ = -1;
   int num_negative_pivots_ = 0;
   bool supernodal_ = false;
+  Ordering ordering_ = Ordering::kAmd;
   SupernodalCholesky supernodal_factor_;  // the factor when supernodal_
 
   // Ordering.

@@ -21,6 +21,7 @@ PACKAGES=(
   libfcl-dev
   libccd-dev
   libtinyobjloader-dev
+  libmetis-dev
   # CHOLMOD and a serial BLAS, only for the opt-in -DTAUT_WITH_CHOLMOD=ON build (GPL-2+), which
   # scripts/run_tests.sh builds and tests in build/cholmod; the default build does not link them.
   libsuitesparse-dev
