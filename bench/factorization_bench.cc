@@ -12,7 +12,7 @@
 // op: factor_solve (numeric factorization + one solve, what every step does) or solve64 (64
 // right-hand sides, the A^-1 J^T columns). Counters: dofs, elements, nnz_L (entries of L),
 // rel_diff, the relative difference of the solution to ldlt's, and (SparseLdlt) nested_dissection,
-// 1 when its ordering is nested dissection.
+// 1 when its ordering is nested dissection, and factor_work, its multiply-adds per factorization.
 //   taut_bench --benchmark_filter=BM_Factorization
 #include <benchmark/benchmark.h>
 
@@ -188,6 +188,11 @@ double UsesNestedDissection(const SparseLdlt& s) {
 double UsesNestedDissection(const CholmodCholesky&) { return 0.0; }
 double UsesNestedDissection(const EigenLlt&) { return 0.0; }
 
+// Multiply-adds of one factorization (SparseLdlt::CalcFactorWork; 0 for the other backends).
+double FactorWork(const SparseLdlt& s) { return s.CalcFactorWork(); }
+double FactorWork(const CholmodCholesky&) { return 0.0; }
+double FactorWork(const EigenLlt&) { return 0.0; }
+
 // Entries of L of each backend (CHOLMOD: stored supernodal entries).
 double EntriesOfL(const SparseLdlt& s) { return s.nonzeros_in_L(); }
 double EntriesOfL(const CholmodCholesky& s) { return s.stored_entries_in_L(); }
@@ -229,6 +234,7 @@ void RunBackend(benchmark::State& state, Solver& solver, Op op, const CaseSpec& 
   state.counters["nnz_L"] = EntriesOfL(solver);
   state.counters["rel_diff"] = diff;
   state.counters["nested_dissection"] = UsesNestedDissection(solver);
+  state.counters["factor_work"] = FactorWork(solver);
 }
 
 // The backends.

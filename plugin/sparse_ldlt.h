@@ -46,9 +46,10 @@ class SparseLdlt {
   static constexpr double kSupernodalMinWork = 2e6;
   // Fill-reducing ordering: chosen (kAuto: AMD, and where AMD's factor work is at least
   // kNestedDissectionMinWork, about 5k-tet bodies, nested dissection instead when its factor has
-  // less work and no more nonzeros), or forced.
+  // at most kNestedDissectionWorkRatio times the work and no more nonzeros), or forced.
   enum class Ordering { kAuto, kAmd, kNestedDissection };
   static constexpr double kNestedDissectionMinWork = 3e7;
+  static constexpr double kNestedDissectionWorkRatio = 0.85;
 
   // Largest number of right-hand sides SolveColumns carries through one pass over L.
   static constexpr int kMaxBlockColumns = 16;
