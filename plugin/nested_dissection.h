@@ -1,7 +1,7 @@
 // Nested-dissection fill-reducing ordering of a symmetric sparse pattern, by METIS (Karypis and
 // Kumar, "A fast and high quality multilevel scheme for partitioning irregular graphs", SIAM J.
 // Sci. Comput. 20(1), 1998; METIS_NodeND). SparseLdlt uses it beside AMD for large bodies and keeps
-// the ordering whose factor is smaller (docs/solver.md, "Orderings").
+// it where it saves enough factor work (docs/solver.md, "Orderings").
 #pragma once
 
 #include <Eigen/SparseCore>

@@ -10,7 +10,8 @@
 
 namespace taut {
 
-// Symbolic phase: validate, order (AMD), permute the pattern, etree and column counts, buffers.
+// Symbolic phase: validate, order (AMD or nested dissection), permute the pattern, etree and column
+// counts, buffers.
 void SparseLdlt::Analyze(const SparseMatrix& pattern, Kernel kernel, Ordering ordering) {
   analyzed_ = false;
   factorized_ = false;
@@ -28,16 +29,20 @@ void SparseLdlt::Analyze(const SparseMatrix& pattern, Kernel kernel, Ordering or
 
   // AMD on the symmetric pattern triu(A) + triu(A)^T. Eigen returns the inverse permutation:
   // indices()(k) is the old index of the k-th pivot (SimplicialCholesky uses it the same way).
-  Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> new_to_old;
-  Eigen::AMDOrdering<int> amd;
-  amd(pattern.selfadjointView<Eigen::Upper>(), new_to_old);
-  std::vector<int> amd_order(new_to_old.indices().data(), new_to_old.indices().data() + n_);
-  AnalyzeOrdering(pattern, amd_order);
   analyzed_ = true;
-  ordering_ = Ordering::kAmd;
-  if (ordering == Ordering::kNestedDissection ||
-      (ordering == Ordering::kAuto && CalcFactorWork() >= kNestedDissectionMinWork))
-    ChooseNestedDissection(pattern, amd_order, ordering == Ordering::kNestedDissection);
+  if (ordering == Ordering::kNestedDissection) {
+    AnalyzeOrdering(pattern, CalcNestedDissectionOrdering(pattern, /*blocks_of_three=*/true));
+    ordering_ = Ordering::kNestedDissection;
+  } else {
+    Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int> new_to_old;
+    Eigen::AMDOrdering<int> amd;
+    amd(pattern.selfadjointView<Eigen::Upper>(), new_to_old);
+    std::vector<int> amd_order(new_to_old.indices().data(), new_to_old.indices().data() + n_);
+    AnalyzeOrdering(pattern, amd_order);
+    ordering_ = Ordering::kAmd;
+    if (ordering == Ordering::kAuto && CalcFactorWork() >= kNestedDissectionMinWork)
+      ChooseNestedDissection(pattern, amd_order);
+  }
   supernodal_ = kernel == Kernel::kSupernodal ||
                 (kernel == Kernel::kAuto && CalcFactorWork() >= kSupernodalMinWork);
 
@@ -67,7 +72,7 @@ void SparseLdlt::AnalyzeOrdering(const SparseMatrix& pattern, const std::vector<
 }
 
 void SparseLdlt::ChooseNestedDissection(const SparseMatrix& pattern,
-                                        const std::vector<int>& amd_order, bool forced) {
+                                        const std::vector<int>& amd_order) {
   // Large 3D meshes fill less under nested dissection than under AMD: the supernodal
   // factor + solve of the 100k-tet cantilever took 0.62x the time at 0.57x the work and 0.75x the
   // nonzeros. A smaller gain in work did not show in time (20k and 25k tets: 0.90x and 0.97x the
@@ -77,8 +82,8 @@ void SparseLdlt::ChooseNestedDissection(const SparseMatrix& pattern,
   const double amd_work = CalcFactorWork();
   const int amd_nonzeros = nonzeros_in_L();
   AnalyzeOrdering(pattern, CalcNestedDissectionOrdering(pattern, /*blocks_of_three=*/true));
-  if (forced || (CalcFactorWork() <= kNestedDissectionWorkRatio * amd_work &&
-                 nonzeros_in_L() <= amd_nonzeros)) {
+  if (CalcFactorWork() <= kNestedDissectionWorkRatio * amd_work &&
+      nonzeros_in_L() <= amd_nonzeros) {
     ordering_ = Ordering::kNestedDissection;
     return;
   }

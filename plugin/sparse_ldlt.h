@@ -55,7 +55,7 @@ class SparseLdlt {
   static constexpr int kMaxBlockColumns = 16;
 
   // Symbolic phase: the ordering of the symmetric pattern (AMD; nested dissection instead where it
-  // gives the smaller factor, see Ordering), elimination tree, column counts of L,
+  // saves enough factor work, see Ordering), elimination tree, column counts of L,
   // the map from A's values to the permuted upper triangle, and every workspace. Values are
   // ignored. Throws InputError for a non-square, empty or uncompressed matrix.
   void Analyze(const SparseMatrix& pattern, Kernel kernel = Kernel::kAuto,
@@ -112,10 +112,9 @@ class SparseLdlt {
  private:
   // perm_ = order (new -> old), then C and the elimination tree for it.
   void AnalyzeOrdering(const SparseMatrix& pattern, const std::vector<int>& order);
-  // Analyzes the nested-dissection ordering and keeps it when `forced` or when its factor is
-  // smaller than AMD's (analyzed on entry), else analyzes `amd_order` again.
-  void ChooseNestedDissection(const SparseMatrix& pattern, const std::vector<int>& amd_order,
-                              bool forced);
+  // Analyzes the nested-dissection ordering and keeps it when it saves enough over AMD's factor
+  // (analyzed on entry; see Ordering), else analyzes `amd_order` again.
+  void ChooseNestedDissection(const SparseMatrix& pattern, const std::vector<int>& amd_order);
   // Builds the permuted upper triangle C = triu(P A P^T) as structure plus a map into A's values.
   void BuildPermutedUpper(const SparseMatrix& pattern);
   // Elimination tree of C and the nonzero count of every column of L (Davis' LDL symbolic).
