@@ -57,7 +57,9 @@ const LdltCase& GetCase(const benchmark::State& state) {
 }
 
 // What a benchmark times.
-enum class Op { kFactor, kSolve1, kSolve64Dense, kSolve64Sparse };
+// kSolve1Single: one right-hand side through the single-precision copy of L (the kept-factor
+// preconditioner's solve; the double solve for the up-looking kernel).
+enum class Op { kFactor, kSolve1, kSolve1Single, kSolve64Dense, kSolve64Sparse };
 
 // Times one operation with SparseLdlt and the given numeric kernel (kAuto: as a body gets it).
 void RunTaut(benchmark::State& state, Op op, SparseLdlt::Kernel kernel) {
@@ -65,6 +67,7 @@ void RunTaut(benchmark::State& state, Op op, SparseLdlt::Kernel kernel) {
   SparseLdlt ldlt;
   ldlt.Analyze(c.A, kernel);
   if (!ldlt.Factorize(c.A)) state.SkipWithError("factorization failed");
+  if (op == Op::kSolve1Single) ldlt.MakeSinglePrecisionCopy();
   VecX x = c.b;
   MatX X = c.B_dense;
   for (auto _ : state) {
@@ -75,6 +78,10 @@ void RunTaut(benchmark::State& state, Op op, SparseLdlt::Kernel kernel) {
       case Op::kSolve1:
         x = c.b;
         ldlt.Solve(x);
+        break;
+      case Op::kSolve1Single:
+        x = c.b;
+        ldlt.SolveSinglePrecision(x);
         break;
       case Op::kSolve64Dense:
         X = c.B_dense;
@@ -108,6 +115,7 @@ void RunEigen(benchmark::State& state, Op op) {
         ldlt.factorize(c.A);
         break;
       case Op::kSolve1:
+      case Op::kSolve1Single:
         x = ldlt.solve(c.b);
         break;
       case Op::kSolve64Dense:
@@ -131,6 +139,7 @@ BENCHMARK_CAPTURE(RunTaut, Factor, Op::kFactor, Kernel::kAuto) TAUT_LDLT_SIZES;
 BENCHMARK_CAPTURE(RunEigen, Factor, Op::kFactor) TAUT_LDLT_SIZES;
 BENCHMARK_CAPTURE(RunTaut, Solve1, Op::kSolve1, Kernel::kAuto) TAUT_LDLT_SIZES;
 BENCHMARK_CAPTURE(RunEigen, Solve1, Op::kSolve1) TAUT_LDLT_SIZES;
+BENCHMARK_CAPTURE(RunTaut, Solve1Single, Op::kSolve1Single, Kernel::kAuto) TAUT_LDLT_SIZES;
 BENCHMARK_CAPTURE(RunTaut, Solve64Dense, Op::kSolve64Dense, Kernel::kAuto) TAUT_LDLT_SIZES;
 BENCHMARK_CAPTURE(RunEigen, Solve64Dense, Op::kSolve64Dense) TAUT_LDLT_SIZES;
 BENCHMARK_CAPTURE(RunTaut, Solve64Sparse, Op::kSolve64Sparse, Kernel::kAuto) TAUT_LDLT_SIZES;

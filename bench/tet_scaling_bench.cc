@@ -51,12 +51,14 @@ void BM_TetBeamScaling(benchmark::State& state) {
   body->FixNodesWhere([](const Vec3& X) { return X.x() < 1e-9; });
   const double dt = 1.0 / 240.0;
   holder.world.stepSimulation(dt, 1, dt);
-  int factored = 0;
+  int factored = 0, pcg_iterations = 0;
   for (auto _ : state) {
     holder.world.stepSimulation(dt, 1, dt);
     if (body->last_pcg_iterations() == 0) ++factored;
+    pcg_iterations += body->last_pcg_iterations();
   }
   state.counters["factored"] = static_cast<double>(factored) / kTimedSteps;
+  state.counters["pcg_iterations"] = static_cast<double>(pcg_iterations) / kTimedSteps;
   state.counters["supernodal"] = body->system().uses_supernodal_factor() ? 1.0 : 0.0;
   state.counters["tets"] = static_cast<double>(mesh->tets.size());
   state.counters["dofs"] = 3.0 * static_cast<double>(mesh->nodes.size());

@@ -128,6 +128,7 @@ int ImplicitSystem::SolveStep(Eigen::Ref<VecX> rhs, const std::string& body,
   if (try_kept) {
     const int n = num_free_dofs();
     for (int i = 0; i < n; ++i) cg_x_[i] = rhs[free_to_dof_[i]];
+    ldlt_.MakeSinglePrecisionCopy();  // once per factor: the preconditioner's solves read fl32(L)
     const int iterations = SolveByKeptFactor(cg_x_, reuse.pcg_tolerance, static_cast<int>(cost));
     if (iterations >= 0) {
       rhs.setZero();
@@ -143,11 +144,11 @@ int ImplicitSystem::SolveStep(Eigen::Ref<VecX> rhs, const std::string& body,
 
 int ImplicitSystem::SolveByKeptFactor(VecX& b_then_x, double tolerance, int max_iterations) const {
   // Preconditioned CG (Saad, Iterative Methods, Alg. 9.1) with P = the kept L D L^T of an earlier
-  // A, from x_0 = P^-1 b.
+  // A (its single-precision copy where one is kept), from x_0 = P^-1 b.
   cg_r_ = b_then_x;  // r = b
   const double threshold = tolerance * b_then_x.norm();
-  if (threshold == 0.0) return 0;  // b = 0: x = 0
-  ldlt_.Solve(b_then_x);           // x_0 = P^-1 b
+  if (threshold == 0.0) return 0;        // b = 0: x = 0
+  ldlt_.SolveSinglePrecision(b_then_x);  // x_0 = P^-1 b
   int applications = 1;
   cg_ap_.noalias() = A_ * b_then_x;
   cg_r_ -= cg_ap_;
@@ -155,7 +156,7 @@ int ImplicitSystem::SolveByKeptFactor(VecX& b_then_x, double tolerance, int max_
   while (cg_r_.norm() > threshold) {
     if (applications >= max_iterations) return -1;
     cg_z_ = cg_r_;
-    ldlt_.Solve(cg_z_);  // z = P^-1 r
+    ldlt_.SolveSinglePrecision(cg_z_);  // z = P^-1 r
     ++applications;
     const double rz = cg_r_.dot(cg_z_);
     if (applications == 2)

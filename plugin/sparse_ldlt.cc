@@ -229,6 +229,19 @@ void SparseLdlt::Solve(Eigen::Ref<VecX> b) const {
   SolveBlock<1>(b.data(), b.size());
 }
 
+void SparseLdlt::MakeSinglePrecisionCopy() {
+  if (supernodal_ && factorized_) supernodal_factor_.MakeSinglePrecisionCopy();
+}
+
+void SparseLdlt::SolveSinglePrecision(Eigen::Ref<VecX> b) const {
+  DemandReadyToSolve(b.size());
+  if (!supernodal_ || !supernodal_factor_.has_single_precision_copy()) return Solve(b);
+  double* w = work_.data();
+  for (int k = 0; k < n_; ++k) w[k] = b[perm_[k]];
+  supernodal_factor_.SolveSinglePrecision(w);
+  for (int k = 0; k < n_; ++k) b[perm_[k]] = w[k];
+}
+
 // Blocks of 16 columns, then one of 8 and one of 4, then single columns.
 void SparseLdlt::SolveColumns(Eigen::Ref<MatX> B) const {
   DemandReadyToSolve(B.rows());

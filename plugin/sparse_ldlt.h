@@ -76,6 +76,13 @@ class SparseLdlt {
   // Factorize or when b has the wrong size.
   void Solve(Eigen::Ref<VecX> b) const;
 
+  // Preconditioner solves: MakeSinglePrecisionCopy keeps fl32(L) of a supernodal factor (after
+  // Factorize; nothing for the up-looking kernel, whose bodies are small), and
+  // SolveSinglePrecision solves with it, exactly for L_f L_f^T in double arithmetic at half the
+  // memory traffic of Solve; without a current copy it is Solve. Same errors as Solve.
+  void MakeSinglePrecisionCopy();
+  void SolveSinglePrecision(Eigen::Ref<VecX> b) const;
+
   // Solves A X = B in place for every column of B (B := X), carrying up to kMaxBlockColumns
   // columns through each pass over L. No heap allocation. Same errors as Solve.
   void SolveColumns(Eigen::Ref<MatX> B) const;

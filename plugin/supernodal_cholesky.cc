@@ -184,6 +184,7 @@ void SupernodalCholesky::BuildScatterMap(const std::vector<int>& c_start,
 bool SupernodalCholesky::Factorize(const double* a_val) {
   failed_column_ = -1;
   failed_pivot_negative_ = false;
+  single_current_ = false;
   std::fill(values_.begin(), values_.end(), 0.0);
   for (size_t q = 0; q < entry_dest_.size(); ++q)
     values_[entry_dest_[q]] += a_val[entry_source_[q]];
@@ -256,14 +257,18 @@ bool SupernodalCholesky::FactorPanel(int t) {
 }
 
 namespace {
-using SolveRowBlock =
-    Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>;
+// A row-major (rows x width) block of right-hand sides; one column maps as a vector, so the
+// triangular solves below take Eigen's vector kernels (the matrix kernels pack their operands,
+// which for a single column costs more than the solve).
+template <int kCols>
+using SolveRowBlock = Eigen::Map<
+    Eigen::Matrix<double, Eigen::Dynamic, kCols, kCols == 1 ? Eigen::ColMajor : Eigen::RowMajor>>;
 }  // namespace
 
 // Forward L Z = Y, one supernode's dense blocks at a time.
-void SupernodalCholesky::SolveLower(double* y_data, int width_b) const {
-  TAUT_ASSERT(width_b <= kMaxSolveColumns);
-  SolveRowBlock y(y_data, n_, width_b);
+template <int kCols>
+void SupernodalCholesky::SolveLowerIn(double* y_data, int width_b) const {
+  SolveRowBlock<kCols> y(y_data, n_, width_b);
   const int num_sn = num_supernodes();
   for (int s = 0; s < num_sn; ++s) {
     const ConstPanel l_s = read_panel(s);
@@ -271,9 +276,9 @@ void SupernodalCholesky::SolveLower(double* y_data, int width_b) const {
     auto y_s = y.middleRows(sn_start_[s], w);
     // Zero rows stay zero (sparse right-hand sides such as columns of J^T).
     if ((y_s.array() == 0.0).all()) continue;
-    l_s.topRows(w).triangularView<Eigen::Lower>().solveInPlace(y_s);
+    l_s.topRows(w).template triangularView<Eigen::Lower>().solveInPlace(y_s);
     if (below == 0) continue;
-    SolveRowBlock t(solve_work_.data(), below, width_b);
+    SolveRowBlock<kCols> t(solve_work_.data(), below, width_b);
     t.noalias() = l_s.bottomRows(below) * y_s;
     const int* rows_below = rows_.data() + row_start_[s] + w;
     for (int k = 0; k < below; ++k) y.row(rows_below[k]) -= t.row(k);
@@ -281,27 +286,146 @@ void SupernodalCholesky::SolveLower(double* y_data, int width_b) const {
 }
 
 // Backward L^T X = Z, supernodes in reverse order.
-void SupernodalCholesky::SolveLowerTransposed(double* y_data, int width_b) const {
-  TAUT_ASSERT(width_b <= kMaxSolveColumns);
-  SolveRowBlock y(y_data, n_, width_b);
+template <int kCols>
+void SupernodalCholesky::SolveLowerTransposedIn(double* y_data, int width_b) const {
+  SolveRowBlock<kCols> y(y_data, n_, width_b);
   for (int s = num_supernodes() - 1; s >= 0; --s) {
     const ConstPanel l_s = read_panel(s);
     const int w = width(s), below = rows_in(s) - w;
     auto y_s = y.middleRows(sn_start_[s], w);
     if (below > 0) {
-      SolveRowBlock t(solve_work_.data(), below, width_b);
+      SolveRowBlock<kCols> t(solve_work_.data(), below, width_b);
       const int* rows_below = rows_.data() + row_start_[s] + w;
       for (int k = 0; k < below; ++k) t.row(k) = y.row(rows_below[k]);
       y_s.noalias() -= l_s.bottomRows(below).transpose() * t;
     }
-    l_s.topRows(w).triangularView<Eigen::Lower>().transpose().solveInPlace(y_s);
+    l_s.topRows(w).template triangularView<Eigen::Lower>().transpose().solveInPlace(y_s);
   }
+}
+
+void SupernodalCholesky::SolveLower(double* y_data, int width_b) const {
+  TAUT_ASSERT(width_b <= kMaxSolveColumns);
+  if (width_b == 1)
+    SolveLowerIn<1>(y_data, width_b);
+  else
+    SolveLowerIn<Eigen::Dynamic>(y_data, width_b);
+}
+
+void SupernodalCholesky::SolveLowerTransposed(double* y_data, int width_b) const {
+  TAUT_ASSERT(width_b <= kMaxSolveColumns);
+  if (width_b == 1)
+    SolveLowerTransposedIn<1>(y_data, width_b);
+  else
+    SolveLowerTransposedIn<Eigen::Dynamic>(y_data, width_b);
 }
 
 // C^-1 = L^-T L^-1.
 void SupernodalCholesky::Solve(double* y_data, int width_b) const {
   SolveLower(y_data, width_b);
   SolveLowerTransposed(y_data, width_b);
+}
+
+void SupernodalCholesky::MakeSinglePrecisionCopy() {
+  if (single_current_) return;
+  values_single_.resize(values_.size());
+  for (size_t k = 0; k < values_.size(); ++k) values_single_[k] = static_cast<float>(values_[k]);
+  single_current_ = true;
+}
+
+namespace {
+constexpr int kSingleBlock = 4;  // panel columns per pass of the single-precision kernels
+
+// Forward solve of one panel (m rows, w columns, column-major fl32 L) on u (m): the leading w x w
+// lower triangle L_tt u_t = u_t, then u_rest -= L_rest u_t, kSingleBlock columns per pass over
+// the rows below them.
+void SolvePanelForward(const float* l, int m, int w, double* u) {
+  int j = 0;
+  for (; j + kSingleBlock <= w; j += kSingleBlock) {
+    const float* c0 = l + static_cast<size_t>(j) * m;
+    const float* c1 = c0 + m;
+    const float* c2 = c1 + m;
+    const float* c3 = c2 + m;
+    const double u0 = u[j] / c0[j];
+    const double u1 = (u[j + 1] - c0[j + 1] * u0) / c1[j + 1];
+    const double u2 = (u[j + 2] - c0[j + 2] * u0 - c1[j + 2] * u1) / c2[j + 2];
+    const double u3 = (u[j + 3] - c0[j + 3] * u0 - c1[j + 3] * u1 - c2[j + 3] * u2) / c3[j + 3];
+    u[j] = u0;
+    u[j + 1] = u1;
+    u[j + 2] = u2;
+    u[j + 3] = u3;
+    for (int i = j + kSingleBlock; i < m; ++i)
+      u[i] -= static_cast<double>(c0[i]) * u0 + static_cast<double>(c1[i]) * u1 +
+              static_cast<double>(c2[i]) * u2 + static_cast<double>(c3[i]) * u3;
+  }
+  for (; j < w; ++j) {
+    const float* c = l + static_cast<size_t>(j) * m;
+    const double u_j = u[j] / c[j];
+    u[j] = u_j;
+    for (int i = j + 1; i < m; ++i) u[i] -= static_cast<double>(c[i]) * u_j;
+  }
+}
+
+// Backward solve of one panel: u_t = L_tt^-T (u_t - L_rest^T u_rest), columns from the last,
+// kSingleBlock per pass (their dot products with the rows below the block in one sweep).
+void SolvePanelBackward(const float* l, int m, int w, double* u) {
+  int j = w;
+  for (; j - kSingleBlock >= 0; j -= kSingleBlock) {
+    const int j0 = j - kSingleBlock;
+    const float* c0 = l + static_cast<size_t>(j0) * m;
+    const float* c1 = c0 + m;
+    const float* c2 = c1 + m;
+    const float* c3 = c2 + m;
+    double d0 = 0.0, d1 = 0.0, d2 = 0.0, d3 = 0.0;
+#pragma omp simd reduction(+ : d0, d1, d2, d3)
+    for (int i = j; i < m; ++i) {
+      d0 += static_cast<double>(c0[i]) * u[i];
+      d1 += static_cast<double>(c1[i]) * u[i];
+      d2 += static_cast<double>(c2[i]) * u[i];
+      d3 += static_cast<double>(c3[i]) * u[i];
+    }
+    const double u3 = (u[j0 + 3] - d3) / c3[j0 + 3];
+    const double u2 = (u[j0 + 2] - d2 - c2[j0 + 3] * u3) / c2[j0 + 2];
+    const double u1 = (u[j0 + 1] - d1 - c1[j0 + 2] * u2 - c1[j0 + 3] * u3) / c1[j0 + 1];
+    const double u0 = (u[j0] - d0 - c0[j0 + 1] * u1 - c0[j0 + 2] * u2 - c0[j0 + 3] * u3) / c0[j0];
+    u[j0] = u0;
+    u[j0 + 1] = u1;
+    u[j0 + 2] = u2;
+    u[j0 + 3] = u3;
+  }
+  for (--j; j >= 0; --j) {
+    const float* c = l + static_cast<size_t>(j) * m;
+    double d = 0.0;
+#pragma omp simd reduction(+ : d)
+    for (int i = j + 1; i < m; ++i) d += static_cast<double>(c[i]) * u[i];
+    u[j] = (u[j] - d) / c[j];
+  }
+}
+}  // namespace
+
+// (L_f L_f^T)^-1 y by panels: each gathers its rows of y into a dense u, solves there
+// (SolvePanelForward / SolvePanelBackward) and scatters back.
+void SupernodalCholesky::SolveSinglePrecision(double* y) const {
+  TAUT_ASSERT(single_current_);
+  double* u = solve_work_.data();
+  const int num_sn = num_supernodes();
+  for (int s = 0; s < num_sn; ++s) {
+    const int w = width(s), m = rows_in(s);
+    const int* rows_s = rows_.data() + row_start_[s];  // the panel's columns, then rows below
+    bool zero = true;
+    for (int k = 0; k < w; ++k) zero = zero && y[rows_s[k]] == 0.0;
+    if (zero) continue;  // zero rows stay zero
+    for (int k = 0; k < m; ++k) u[k] = k < w ? y[rows_s[k]] : 0.0;
+    SolvePanelForward(values_single_.data() + val_start_[s], m, w, u);
+    for (int k = 0; k < w; ++k) y[rows_s[k]] = u[k];
+    for (int k = w; k < m; ++k) y[rows_s[k]] += u[k];
+  }
+  for (int s = num_sn - 1; s >= 0; --s) {
+    const int w = width(s), m = rows_in(s);
+    const int* rows_s = rows_.data() + row_start_[s];
+    for (int k = 0; k < m; ++k) u[k] = y[rows_s[k]];
+    SolvePanelBackward(values_single_.data() + val_start_[s], m, w, u);
+    for (int k = 0; k < w; ++k) y[rows_s[k]] = u[k];
+  }
 }
 
 void SupernodalCholesky::CalcPivots(std::vector<double>& d) const {

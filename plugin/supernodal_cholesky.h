@@ -45,6 +45,15 @@ class SupernodalCholesky {
   void SolveLower(double* y, int width) const;
   void SolveLowerTransposed(double* y, int width) const;
 
+  // A single-precision copy of L (made after Factorize) and the solve C X = Y for one column
+  // through it, in double arithmetic: an exact solve with the SPD matrix L_f L_f^T, L_f = fl32(L),
+  // that reads half the bytes of Solve. For preconditioning, where the factor is an earlier A's
+  // and a 1e-7 relative change of L is far below that difference. Solve needs the copy made since
+  // the last Factorize.
+  void MakeSinglePrecisionCopy();
+  bool has_single_precision_copy() const { return single_current_; }
+  void SolveSinglePrecision(double* y) const;
+
   // Pivots of the equivalent LDL^T: D_jj = L_jj^2 (valid after a successful Factorize).
   void CalcPivots(std::vector<double>& d) const;
 
@@ -75,6 +84,11 @@ class SupernodalCholesky {
   void SubtractUpdate(int d, int k1, int k2, int t);
   // Step 3: dense Cholesky of t's diagonal block and the triangular solve below it.
   bool FactorPanel(int t);
+  // The solves' halves for kCols right-hand sides (1: vector kernels; Eigen::Dynamic: blocks).
+  template <int kCols>
+  void SolveLowerIn(double* y_data, int width_b) const;
+  template <int kCols>
+  void SolveLowerTransposedIn(double* y_data, int width_b) const;
 
   Panel panel(int s) { return Panel(values_.data() + val_start_[s], rows_in(s), width(s)); }
   ConstPanel read_panel(int s) const {
@@ -84,12 +98,14 @@ class SupernodalCholesky {
   int rows_in(int s) const { return row_start_[s + 1] - row_start_[s]; }
 
   int n_ = 0;
-  std::vector<int> sn_start_;   // (S + 1) first column of each supernode
-  std::vector<int> sn_of_;      // (n) supernode of each column
-  std::vector<int> row_start_;  // (S + 1) start of each panel's rows in rows_
-  std::vector<int> rows_;       // row indices of all panels, ascending within one
-  std::vector<int> val_start_;  // (S + 1) start of each panel in values_
-  std::vector<double> values_;  // panels, column-major, leading dimension rows_in(s)
+  std::vector<int> sn_start_;         // (S + 1) first column of each supernode
+  std::vector<int> sn_of_;            // (n) supernode of each column
+  std::vector<int> row_start_;        // (S + 1) start of each panel's rows in rows_
+  std::vector<int> rows_;             // row indices of all panels, ascending within one
+  std::vector<int> val_start_;        // (S + 1) start of each panel in values_
+  std::vector<double> values_;        // panels, column-major, leading dimension rows_in(s)
+  std::vector<float> values_single_;  // fl32(values_) once MakeSinglePrecisionCopy ran
+  bool single_current_ = false;       // values_single_ holds the last Factorize's L
 
   // A's entries: values_[entry_dest_[q]] += a_val[entry_source_[q]].
   std::vector<int> entry_dest_;

@@ -103,5 +103,38 @@ TEST(SupernodalCholeskyTest, FailsOnAMatrixThatIsNotPositiveDefinite) {
   EXPECT_TRUE(sn.factorized());
 }
 
+// The preconditioner solve through fl32(L): a symmetric operator (forward and backward halves
+// use the same rounded L), within single-precision rounding of A^-1 but not equal to it, and
+// Solve again once a new Factorize makes the copy stale.
+TEST(SupernodalCholeskyTest, SinglePrecisionSolveInvertsTheRoundedFactor) {
+  SnSparse A = testing::MakeRandomTetBlockSpd(10, 4, 3, 11);
+  SparseLdlt sn;
+  sn.Analyze(A, SparseLdlt::Kernel::kSupernodal);
+  ASSERT_TRUE(sn.Factorize(A));
+  const MatX B = MakeSnRhs(static_cast<int>(A.rows()), 2, 12);
+  VecX x_double = B.col(0), x_single = B.col(0);
+  sn.Solve(x_double);
+  sn.SolveSinglePrecision(x_single);  // no copy yet: the double solve
+  EXPECT_EQ(x_single, x_double);
+  sn.MakeSinglePrecisionCopy();
+  x_single = B.col(0);
+  sn.SolveSinglePrecision(x_single);
+  const double difference = (x_single - x_double).norm() / x_double.norm();
+  EXPECT_GT(difference, 1e-12);  // the rounded factor was used
+  EXPECT_LT(difference, 1e-5);
+  // u^T P^-1 v = v^T P^-1 u for P = L_f L_f^T.
+  VecX p_u = B.col(0), p_v = B.col(1);
+  sn.SolveSinglePrecision(p_u);
+  sn.SolveSinglePrecision(p_v);
+  EXPECT_NEAR(B.col(1).dot(p_u), B.col(0).dot(p_v), 1e-12 * p_u.norm() * B.col(1).norm());
+  // P^-1 is positive definite.
+  EXPECT_GT(B.col(0).dot(p_u), 0.0);
+  // A new factorization leaves the copy stale: the double solve of the new A again.
+  ASSERT_TRUE(sn.Factorize(A));
+  VecX x_after = B.col(0);
+  sn.SolveSinglePrecision(x_after);
+  EXPECT_EQ(x_after, x_double);
+}
+
 }  // namespace
 }  // namespace taut
