@@ -43,7 +43,7 @@ class SparseLdlt {
   // Numeric kernel: chosen by size (kAuto), or forced.
   enum class Kernel { kAuto, kUpLooking, kSupernodal };
   // Factorization work (CalcFactorWork) from which kAuto picks the supernodal kernel.
-  static constexpr double kSupernodalMinWork = 2e6;
+  static constexpr double kSupernodalMinWork = 1e5;
   // Fill-reducing ordering: chosen (kAuto: AMD, and where AMD's factor work is at least
   // kNestedDissectionMinWork, about 5k-tet bodies, nested dissection instead when its factor has
   // at most kNestedDissectionWorkRatio times the work and no more nonzeros), or forced.

