@@ -147,8 +147,8 @@ int ImplicitSystem::SolveByKeptFactor(VecX& b_then_x, double tolerance, int max_
   // A (its single-precision copy where one is kept), from x_0 = P^-1 b.
   cg_r_ = b_then_x;  // r = b
   const double threshold = tolerance * b_then_x.norm();
-  if (threshold == 0.0) return 0;        // b = 0: x = 0
-  ldlt_.SolveSinglePrecision(b_then_x);  // x_0 = P^-1 b
+  if (threshold == 0.0) return 0;  // b = 0: x = 0
+  ldlt_.Solve(b_then_x);  // x_0 = P^-1 b in double: exact where A has not changed (at rest)
   int applications = 1;
   cg_ap_.noalias() = A_ * b_then_x;
   cg_r_ -= cg_ap_;
