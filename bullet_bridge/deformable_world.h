@@ -195,6 +195,10 @@ class DeformableWorldOf : public BulletWorld {
   // multibodies' state is not part of it). A snapshot fits this world and any
   // world built the same way (same bodies, objects and joints in the same order).
   WorldSnapshot SaveSnapshot() const;
+  // The same into `snapshot`, reusing its storage: saved again and again into one object (a
+  // take-back point saved every step), it allocates nothing for the bodies' states after the
+  // first time. Restoring it gives the same world as restoring a fresh SaveSnapshot().
+  void SaveSnapshot(WorldSnapshot& snapshot) const;
   // Throws InputError saying what does not match, and changes nothing, when the snapshot is of a
   // world with other deformables (count, nodes, elements), collision objects (count, kind,
   // shape) or joints.

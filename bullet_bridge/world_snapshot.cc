@@ -49,10 +49,13 @@ int CountFreeNodes(const std::vector<NodeKind>& kinds) {
 template <class BulletWorld>
 void DeformableWorldOf<BulletWorld>::Snapshots::SaveDeformables(const DeformableWorldOf& world,
                                                                 WorldSnapshot& snapshot) {
-  for (const auto& entry : world.bodies_) {
-    const DeformableBody& body = entry->object->body();
-    snapshot.deformables.push_back(
-        {body.num_elements(), body.SaveState(), entry->solver.SaveState()});
+  snapshot.deformables.resize(world.bodies_.size());
+  for (size_t b = 0; b < world.bodies_.size(); ++b) {
+    const Entry& entry = *world.bodies_[b];
+    WorldSnapshot::Deformable& saved = snapshot.deformables[b];
+    saved.num_elements = entry.object->body().num_elements();
+    entry.object->body().SaveState(saved.body);
+    entry.solver.SaveState(saved.solver);
   }
 }
 
@@ -62,6 +65,7 @@ void DeformableWorldOf<BulletWorld>::Snapshots::SaveSourceIds(const DeformableWo
   std::vector<const Entry*> entries;
   for (const auto& entry : world.bodies_) entries.push_back(entry.get());
   const auto index = IndexByPointer(entries);
+  snapshot.pair_contacts.clear();
   for (const auto& [key, pair] : world.pair_contacts_)
     snapshot.pair_contacts.push_back(
         {FindIndex(index, key.first), FindIndex(index, key.second), pair.source_id});
@@ -81,6 +85,9 @@ void DeformableWorldOf<BulletWorld>::Snapshots::SaveForces(const DeformableWorld
   const auto object_index = IndexByPointer(objects);
   WorldSnapshot::Forces& forces = snapshot.forces;
   forces.values = world.forces_;
+  forces.contacts.clear();
+  forces.wrenches.clear();
+  forces.limits.clear();
   for (DeformableContactPoint& contact : forces.values.contacts) {
     forces.contacts.push_back({FindIndex(body_index, contact.body),
                                FindIndex(body_index, contact.partner_body),
@@ -204,6 +211,12 @@ void DeformableWorldOf<BulletWorld>::Snapshots::RestoreForces(DeformableWorldOf&
 template <class BulletWorld>
 WorldSnapshot DeformableWorldOf<BulletWorld>::SaveSnapshot() const {
   WorldSnapshot snapshot;
+  SaveSnapshot(snapshot);
+  return snapshot;
+}
+
+template <class BulletWorld>
+void DeformableWorldOf<BulletWorld>::SaveSnapshot(WorldSnapshot& snapshot) const {
   Snapshots::SaveDeformables(*this, snapshot);
   Snapshots::SaveSourceIds(*this, snapshot);
   snapshot.bullet = SaveBulletWorldState(*this);
@@ -212,7 +225,6 @@ WorldSnapshot DeformableWorldOf<BulletWorld>::SaveSnapshot() const {
   snapshot.last_step_stats = stats_;
   snapshot.last_call_stats = call_stats_;
   Snapshots::SaveForces(*this, snapshot);
-  return snapshot;
 }
 
 template <class BulletWorld>
@@ -231,8 +243,10 @@ void DeformableWorldOf<BulletWorld>::RestoreSnapshot(const WorldSnapshot& snapsh
 }
 
 template WorldSnapshot DeformableWorldOf<btDiscreteDynamicsWorld>::SaveSnapshot() const;
+template void DeformableWorldOf<btDiscreteDynamicsWorld>::SaveSnapshot(WorldSnapshot&) const;
 template void DeformableWorldOf<btDiscreteDynamicsWorld>::RestoreSnapshot(const WorldSnapshot&);
 template WorldSnapshot DeformableWorldOf<btMultiBodyDynamicsWorld>::SaveSnapshot() const;
+template void DeformableWorldOf<btMultiBodyDynamicsWorld>::SaveSnapshot(WorldSnapshot&) const;
 template void DeformableWorldOf<btMultiBodyDynamicsWorld>::RestoreSnapshot(const WorldSnapshot&);
 
 }  // namespace taut

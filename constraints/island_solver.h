@@ -79,9 +79,14 @@ class IslandSolver {
     bool primal_refactor_next = false;  // PrimalSolver::refactor_next of the last primal solve
   };
   State SaveState() const {
-    State state = state_;
-    state.primal_refactor_next = primal_.refactor_next();
+    State state;
+    SaveState(state);
     return state;
+  }
+  // The same into `state`, reusing its storage.
+  void SaveState(State& state) const {
+    state = state_;
+    state.primal_refactor_next = primal_.refactor_next();
   }
   void RestoreState(const State& state) {
     state_ = state;

@@ -245,14 +245,19 @@ void DeformableBody::FailStep(const std::string& what, const char* stage) {
 
 DeformableBody::State DeformableBody::SaveState() const {
   State state;
+  SaveState(state);
+  return state;
+}
+
+void DeformableBody::SaveState(State& state) const {
   state.x = x_;
   state.v = v_;
   state.external = external_;
   state.kinds = kinds_;
   state.kinematic_targets = kinematic_targets_;
   state.kinds_changed = kinds_changed_;
-  if (!kinds_changed_) state.newton = system_.SaveNewtonState();
-  return state;
+  // With kinds_changed the restore rebuilds the system and ignores `newton`.
+  if (!kinds_changed_) system_.SaveNewtonState(state.newton);
 }
 
 void DeformableBody::RestoreState(const State& state) {

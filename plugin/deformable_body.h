@@ -146,6 +146,9 @@ class DeformableBody {
     ImplicitSystem::NewtonState newton;   // the primal solver's Newton factor, reused later
   };
   State SaveState() const;
+  // The same into `state`, reusing its storage: a state saved again and again into one object
+  // allocates nothing after the first time (a real-time loop's take-back point).
+  void SaveState(State& state) const;
   // Puts a saved state back, rebuilding the system when the node kinds differ. Between steps
   // only. Throws InputError naming the body, and changes nothing, when the state is of a body
   // with another number of nodes or its Newton state does not fit.

@@ -324,14 +324,23 @@ double ImplicitSystem::CalcNewtonRefactorCost() const {
 
 ImplicitSystem::NewtonState ImplicitSystem::SaveNewtonState() const {
   NewtonState state;
-  if (use_cholmod_) return state;
+  SaveNewtonState(state);
+  return state;
+}
+
+void ImplicitSystem::SaveNewtonState(NewtonState& state) const {
+  state.analyzed = false;
+  state.exact_solves = false;
+  if (use_cholmod_) {
+    state = NewtonState();
+    return;
+  }
   state.system_factor = ldlt_;
   state.exact_solves = exact_solves_;
-  if (!newton_analyzed_) return state;
+  if (!newton_analyzed_) return;
   state.analyzed = true;
   state.H = H_;
   state.factor = newton_ldlt_;
-  return state;
 }
 
 void ImplicitSystem::RestoreNewtonState(const NewtonState& state) {
@@ -348,8 +357,14 @@ void ImplicitSystem::RestoreNewtonState(const NewtonState& state) {
               state.system_factor.rows(), " free DOFs does not fit this system (", num_free_dofs(),
               " free DOFs)");
   newton_analyzed_ = state.analyzed;
-  H_ = state.H;
-  newton_ldlt_ = state.factor;
+  // Without an analysis the saved H and factor are unused (SaveNewtonState may leave old ones).
+  if (state.analyzed) {
+    H_ = state.H;
+    newton_ldlt_ = state.factor;
+  } else {
+    H_ = Eigen::SparseMatrix<double>();
+    newton_ldlt_ = SparseLdlt();
+  }
   if (factor_fits) ldlt_ = state.system_factor;
   factor_current_ = false;  // A is assembled again by the next step
   exact_solves_ = state.exact_solves;

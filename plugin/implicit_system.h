@@ -138,6 +138,9 @@ class ImplicitSystem {
     bool exact_solves = false;  // the last step's constraint solve needed this step's A^-1
   };
   NewtonState SaveNewtonState() const;
+  // The same into `state`, reusing its storage (no allocation once it has held a state of this
+  // system). H and factor are left as they were when `analyzed` comes out false: unused then.
+  void SaveNewtonState(NewtonState& state) const;
   // Puts a saved state back (CHOLMOD: no-op). The system must be built with the node kinds of the
   // saved one; throws InputError, changing nothing, when H's size or pattern size differ.
   void RestoreNewtonState(const NewtonState& state);

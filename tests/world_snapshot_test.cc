@@ -172,6 +172,38 @@ TEST_P(WorldSnapshotTest, SnapshotRestoresIntoAnotherWorldBuiltTheSameWay) {
   }
 }
 
+TEST_P(WorldSnapshotTest, SnapshotSavedIntoAUsedOneRestoresLikeAFreshOne) {
+  const SceneMaker make = [] { return MakeTetScene(GetParam()); };
+  const uint64_t uninterrupted = RunUninterrupted(make);
+  // The object first holds a state of a world that ran elsewhere on the other path: other
+  // warm starts, contacts and Newton matrices (the primal path analyzes H, the dual one not).
+  const IslandSolverKind other =
+      GetParam() == IslandSolverKind::kPrimal ? IslandSolverKind::kDual : IslandSolverKind::kPrimal;
+  std::unique_ptr<TestScene> elsewhere = MakeTetScene(other);
+  RunCalls(*elsewhere, kCallsBefore + kCallsAfter);
+  WorldSnapshot snapshot;
+  elsewhere->world().SaveSnapshot(snapshot);
+  ASSERT_FALSE(snapshot.deformables[0].solver.warm.empty());
+
+  std::unique_ptr<TestScene> scene = make();
+  RunCalls(*scene, kCallsBefore);
+  scene->world().SaveSnapshot(snapshot);
+  const WorldSnapshot fresh = scene->world().SaveSnapshot();
+  for (size_t b = 0; b < fresh.deformables.size(); ++b) {
+    const WorldSnapshot::Deformable& reused = snapshot.deformables[b];
+    EXPECT_EQ(reused.body.x, fresh.deformables[b].body.x);
+    EXPECT_EQ(reused.body.newton.analyzed, fresh.deformables[b].body.newton.analyzed);
+    EXPECT_EQ(reused.solver.warm, fresh.deformables[b].solver.warm);
+  }
+  EXPECT_EQ(snapshot.pair_contacts.size(), fresh.pair_contacts.size());
+  EXPECT_EQ(snapshot.forces.contacts, fresh.forces.contacts);
+  EXPECT_EQ(snapshot.forces.limits, fresh.forces.limits);
+  Diverge(*scene);
+  scene->world().RestoreSnapshot(snapshot);
+  RunCalls(*scene, kCallsAfter);
+  EXPECT_EQ(scene->CalcStateHash(), uninterrupted);
+}
+
 TEST_P(WorldSnapshotTest, RestoredHexWorldContinuesBitIdentically) {
   const SceneMaker make = [] { return MakeHexScene(GetParam()); };
   const uint64_t uninterrupted = RunUninterrupted(make);

@@ -198,7 +198,7 @@ void FingerScene::Simulate(double dt) {
   // Only an advance against the table can lock; a snapshot before it lets it be taken back.
   const bool guarded =
       settings_.take_back_locked_advances && !stopped_ && results_[current_].touched;
-  if (guarded) advance_start_ = world().SaveSnapshot();
+  if (guarded) world().SaveSnapshot(advance_start_);  // in place: no allocation per step
   UpdateBoneTravel(dt);
   Scene::Simulate(dt);
   if (guarded && !world().last_step_stats().converged) RetreatFromLockedAdvance(dt);
