@@ -48,6 +48,10 @@ struct ConstraintRow {
   // rows of equal axis limits, whose C depends on one stretch only): the primal path's model of
   // Phi is trusted for model steps (docs/math.md §5.8, model steps).
   bool exact_curvature = false;
+  // J^T (-d^2C/dx^2) J of a limit row whose source knows it (energy rows), else 0: with the
+  // row's multiplier, the stiffness its own curvature adds along J, which the primal path's
+  // penalty counts in the row's effective mass (docs/math.md §5.8, penalties).
+  double curvature_along_j = 0.0;
   std::array<int, kMaxRowNodes> nodes{};  // node indices in the body
   std::array<Vec3, kMaxRowNodes> J{};     // dC/dx_node
   int body2 = -1;                         // side B's body in the island, -1 when one-sided

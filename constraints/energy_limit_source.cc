@@ -29,11 +29,15 @@ double EnergyLimitSource::CalcElementEnergy(const VecX& x, int e) const {
 }
 
 void EnergyLimitSource::FillRow(const VecX& x, int e, ConstraintRow& row) const {
-  // R recomputed from x, then frozen for the Jacobian J = f_e / U_max (docs/math.md §4.5).
+  // R recomputed from x, then frozen for the Jacobian J = f_e / U_max (docs/math.md §4.5) and
+  // the curvature -d^2C/dx^2 = K_e(R) / U_max (AddIslandCurvature): along J,
+  // J^T K_e J / U_max = f^T K_e f / U_max^3.
   const ElementModel& model = body_.model();
   ElementVectors forces;
-  const double energy = model.CalcElementForces(e, x, forces);
+  double f_K_f = 0.0;
+  const double energy = model.CalcElementForcesAndStiffnessAlong(e, x, forces, &f_K_f);
   row.C = CalcEnergyLimitValue(energy, u_max_[e]);
+  row.curvature_along_j = f_K_f / (u_max_[e] * u_max_[e] * u_max_[e]);
   row.num_nodes = model.nodes_per_element();
   CalcEnergyLimitJacobian(forces.data(), row.num_nodes, u_max_[e], row.J.data());
   const int* nodes = model.element_nodes(e);

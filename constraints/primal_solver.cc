@@ -56,7 +56,7 @@ double UpperBound(const ConstraintRow& row) {
 }
 }  // namespace
 
-void PrimalSolver::CalcPenalties(const std::vector<IslandBody*>& bodies,
+void PrimalSolver::CalcPenalties(double h, const std::vector<IslandBody*>& bodies,
                                  const PrimalSettings& settings) {
   const int m = rows_.size();
   rho_.setZero(m);
@@ -67,11 +67,24 @@ void PrimalSolver::CalcPenalties(const std::vector<IslandBody*>& bodies,
       continue;
     }
     // w_c = sum_i J_ci^T M_i^-1 J_ci: the diagonal of W with A replaced by its mass part.
-    double w = 0.0;
+    double w = 0.0, jj = 0.0;
     row.ForEachEntry([&](int body, int block, const Vec3& J) {
       w += bodies[body]->CalcBlockMobility(block, J);
+      jj += J.squaredNorm();
     });
-    rho_[c] = w > 0.0 ? settings.penalty_scale / w : 0.0;
+    if (!(w > 0.0)) {
+      rho_[c] = 0.0;
+      continue;
+    }
+    // A pushing row's curvature G_c = h lambda_bar_c (-d^2C/dx^2) stiffens the Newton matrix
+    // along J: with mass |J|^2 / w and stiffness J^T G_c J / |J|^2 along J/|J|, the effective
+    // mobility is 1 / w_eff = 1 / w + h lambda_bar_c J^T (-d^2C) J / |J|^4. Without it, rho of
+    // a tiny energy limit (large lambda, curvature K_e / U_max) was far below the multiplier
+    // iteration's need: 40 iterations each cutting the violation only by 0.9 (docs/math.md §5.8,
+    // curvature in the effective mass).
+    rho_[c] = settings.penalty_scale / w;
+    if (row.curvature_along_j > 0.0 && c < lambda_bar_.size() && lambda_bar_[c] > 0.0)
+      rho_[c] += settings.penalty_scale * h * lambda_bar_[c] * row.curvature_along_j / (jj * jj);
   }
   // Within a multiplier iteration limit rows keep the rho they started it with: rho from a trial
   // point's J would make Phi's slope along d disagree with grad Phi . d.
@@ -504,7 +517,7 @@ void PrimalSolver::CollectRowsAt(double h, const std::vector<IslandBody*>& bodie
   const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
   violation_ = rows_.Collect(h, bodies, sources, v, distance_scale);
   rows_.WarmStart(iterate_, lambda_bar_);
-  CalcPenalties(bodies, settings.primal);
+  CalcPenalties(h, bodies, settings.primal);
   for (size_t b = 0; b < bodies.size(); ++b) v_[b] = v[b];
   LinearizeRows(h, bodies);
   jv_.resize(rows_.size());

@@ -71,8 +71,10 @@ class PrimalSolver {
                              const SqpSettings& settings, StepStats& stats);
   // v = v* + A^-1 J^T lambda_bar into v_trial_ (false when there is no warm multiplier).
   bool WarmStartVelocities(const std::vector<IslandBody*>& bodies);
-  // rho_c of every row from the diagonal Delassus estimate (friction rows: their normal's).
-  void CalcPenalties(const std::vector<IslandBody*>& bodies, const PrimalSettings& settings);
+  // rho_c of every row from the diagonal Delassus estimate (friction rows: their normal's), with
+  // a pushing limit row's own curvature in its effective mass.
+  void CalcPenalties(double h, const std::vector<IslandBody*>& bodies,
+                     const PrimalSettings& settings);
   // Keeps the limit rows' rho by key for the Newton iterations and line-search trials of one
   // multiplier iteration, so grad Phi is the gradient of the Phi the line search measures
   // (docs/math.md §5.8, penalties).

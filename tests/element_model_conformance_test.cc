@@ -235,6 +235,30 @@ TYPED_TEST(ElementModelConformanceTest, StiffnessIsMinusTheForceJacobianWithRota
   EXPECT_LT((this->AssembleElementStiffnesses(x) - K).norm(), 1e-12 * K.norm());
 }
 
+TYPED_TEST(ElementModelConformanceTest, StiffnessAlongTheForcesIsTheElementStiffnessQuadraticForm) {
+  // CalcElementForcesAndStiffnessAlong: the forces and energy of CalcElementForces, and
+  // f^T K_e f with K_e = CalcElementStiffness (its rotation from the same x).
+  const ElementModel& model = *this->model_;
+  const VecX x = this->Deform(0.15, TypeParam::kNonAffine);
+  const int m = model.nodes_per_element();
+  for (int e = 0; e < model.num_elements(); ++e) {
+    ElementVectors forces, along_forces;
+    const double energy = model.CalcElementForces(e, x, forces);
+    double f_K_f = -1.0;
+    EXPECT_EQ(model.CalcElementForcesAndStiffnessAlong(e, x, along_forces, &f_K_f), energy);
+    VecX f(3 * m);
+    for (int a = 0; a < m; ++a) {
+      EXPECT_EQ(along_forces[a], forces[a]) << "element " << e << " node " << a;
+      f.segment<3>(3 * a) = forces[a];
+    }
+    ElementMatrix K;
+    model.CalcElementStiffness(e, x, K);
+    const double expected = f.dot(K * f);
+    ASSERT_GT(expected, 0.0);
+    EXPECT_NEAR(f_K_f, expected, 1e-12 * expected) << "element " << e;
+  }
+}
+
 TYPED_TEST(ElementModelConformanceTest, StiffnessIsTheForceJacobianAtARigidPose) {
   // At x = Q X + t the derivative of the rotations adds nothing: -df/dx = K exactly, with the
   // rotations following x.

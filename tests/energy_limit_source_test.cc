@@ -293,6 +293,50 @@ TEST(EnergyLimitSourceTest, HexBodyRowsHaveEightNodesAndTheFrozenRotationJacobia
   for (double limit : density.element_limits()) EXPECT_NEAR(limit, 3.0 * std::pow(0.05, 3), 1e-15);
 }
 
+TEST(EnergyLimitSourceTest, RowCurvatureAlongItsJacobianIsTheFrozenRotationCurvature) {
+  // curvature_along_j = J^T (-d^2C/dx^2) J with the rotation frozen at x (the curvature of
+  // AddIslandCurvature, K_e / U_max). Tets: against CalcTetEnergyLimitCurvature (finite-difference
+  // tested in energy_limit_rows_test.cc). Hexes: -d^2/dt^2 C(x + t J) by central differences of
+  // the frozen-rotation energy (quadratic in t, so exact up to round-off).
+  const double u_max = 1e-9;
+  auto tet_body = MakeCube(2e3, 1);
+  auto hex_body = MakeHexCube(2e3, 2);
+  for (const DeformableBody* body : {tet_body.get(), hex_body.get()}) {
+    const VecX x = Stretched(*body, 0.1);
+    EnergyLimitSource source(*body, EnergyLimitSettings::PerElementEnergy(u_max), 0);
+    std::vector<ConstraintRow> rows;
+    ASSERT_GT(source.AppendRows(x, 0, rows), 0);
+    for (const ConstraintRow& row : rows) {
+      const int e = static_cast<int>(row.key & 0xffffffffffffULL);
+      VecX J_element(3 * row.num_nodes), J = VecX::Zero(x.size());
+      for (int n = 0; n < row.num_nodes; ++n) {
+        J_element.segment<3>(3 * n) = row.J[n];
+        J.segment<3>(3 * row.nodes[n]) = row.J[n];
+      }
+      double expected = 0.0;
+      if (body == tet_body.get()) {
+        const TetElementModel& tets = Tets(*body);
+        const Mat12 H = CalcTetEnergyLimitCurvature(tets.rest().elements[e], tets.lame(),
+                                                    tets.GatherElement(x, e), u_max);
+        expected = J_element.dot(H * J_element);
+      } else {
+        const HexElementModel& hexes = Hexes(*body);
+        const HexRestElement& rest = hexes.rest(e);
+        const Mat3 R =
+            CalcHexRotation(rest, hexes.GatherElement(x, e), HexRotationMethod::kCenterPolar);
+        const auto C = [&](double t) {
+          return 1.0 - CalcCorotatedHexEnergy(rest, hexes.GatherElement(x + t * J, e), R) / u_max;
+        };
+        const double t = 1e-3 / J.norm();
+        expected = -(C(t) - 2.0 * C(0.0) + C(-t)) / (t * t);
+      }
+      ASSERT_GT(expected, 0.0);
+      EXPECT_NEAR(row.curvature_along_j, expected, 1e-6 * expected)
+          << body->name() << " element " << e;
+    }
+  }
+}
+
 TEST(EnergyLimitSourceTest, HangingHexCubeKeepsEveryElementBelowItsEnergyLimit) {
   const double density_limit = 20.0;  // J/m^3
   double free_ratio = 0.0, limited_ratio = 0.0;

@@ -182,6 +182,42 @@ TEST(PrimalSolverTest, StalledLimitRowsGetLargerPenaltiesAndConverge) {
   EXPECT_LE(worst, 1e-3);
 }
 
+TEST(PrimalSolverTest, TinyEnergyLimitsConvergeWithTheirCurvatureInThePenalty) {
+  // A 0.5 m cantilever (10 x 1 x 1 cubes, 60 tets, E = 1e5 Pa) limited to the energy density of
+  // a 1e-4 strain (5e-4 J/m^3; the stress suite's cell): every unconstrained step puts the
+  // elements at ~300 U_max and all 60 rows push. Their curvature K_e / U_max dominates the Newton
+  // matrix along J, so rho from the mass alone was far too small: the multiplier iteration cut
+  // the violation by only ~0.9 per iteration and most steps ended at the 40-iteration cap. With
+  // the curvature in the penalty's effective mass, once the multipliers have ramped up from zero
+  // (the first steps after the release), every step converges in at most a few iterations.
+  BulletWorldHolder holder;
+  DeformableBodySettings settings;
+  settings.name = "cantilever";
+  settings.material = {1e5, 0.3, 1000.0};
+  DeformableBody* body =
+      holder.world.AddTetBody(MakeBoxTetMesh(Vec3(0.5, 0.05, 0.05), 10, 1, 1), settings);
+  body->FixNodesWhere([](const Vec3& X) { return X.x() < 1e-9; });
+  const EnergyLimitSource* limit =
+      holder.world.SetEnergyLimits(body, EnergyLimitSettings::EnergyDensity(0.5 * 1e5 * 1e-8));
+  holder.world.mutable_solver_settings().solver = IslandSolverKind::kPrimal;
+  constexpr int kRampSteps = 3, kSteps = 30;
+  int unconverged = 0, pushing_steps = 0, sqp = 0;
+  double worst_ratio = 0.0;
+  for (int step = 0; step < kSteps; ++step) {
+    holder.world.stepSimulation(1.0 / 240.0, 1, 1.0 / 240.0);
+    const StepStats& stats = holder.world.last_step_stats();
+    pushing_steps += stats.rows_energy > 0 && stats.violation_before > 10.0 ? 1 : 0;
+    if (step < kRampSteps) continue;
+    unconverged += stats.converged ? 0 : 1;
+    sqp += stats.sqp_iterations;
+    worst_ratio = std::max(worst_ratio, limit->CalcMaxEnergyRatio(body->x()));
+  }
+  EXPECT_EQ(pushing_steps, kSteps);  // every step starts far outside the limits
+  EXPECT_EQ(unconverged, 0);
+  EXPECT_LE(sqp, 2 * (kSteps - kRampSteps));
+  EXPECT_LE(worst_ratio, 1.0 + 1e-3);
+}
+
 TEST(PrimalSolverTest, FrameCurvatureHalvesTheAnisotropicBeamsNewtonIterations) {
   // The soft anisotropic beam (240 tets): its rows depend on the principal frame, and without
   // the frame factor's second derivative the Newton matrix underestimates Phi's curvature along
