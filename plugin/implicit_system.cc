@@ -329,16 +329,14 @@ ImplicitSystem::NewtonState ImplicitSystem::SaveNewtonState() const {
 }
 
 void ImplicitSystem::SaveNewtonState(NewtonState& state) const {
-  state.analyzed = false;
-  state.exact_solves = false;
   if (use_cholmod_) {
     state = NewtonState();
     return;
   }
   state.system_factor = ldlt_;
   state.exact_solves = exact_solves_;
+  state.analyzed = newton_analyzed_;
   if (!newton_analyzed_) return;
-  state.analyzed = true;
   state.H = H_;
   state.factor = newton_ldlt_;
 }
