@@ -114,7 +114,8 @@ class IslandSolver {
                  const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
                  StepStats& stats);
   // After a failed step (kAuto, retry_failed_step_on_other_path): the path `other` from the
-  // step's start velocities (start_v_) and warm starts `warm_start`, at most
+  // step's start velocities (start_v_) and warm starts (a dual retry: `warm_start`, the step's
+  // own; a primal retry: the failed dual answer's multipliers), at most
   // retry_max_iterations iterations; keeps the better answer. Returns whether the retry
   // certified the step.
   bool RetryOn(IslandSolverKind other, double h, const std::vector<IslandBody*>& bodies,
