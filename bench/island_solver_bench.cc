@@ -16,7 +16,8 @@
 //   ms_step_wall   median StepStats::ms_total [ms] (steady clock)
 //   ms_unc         median StepStats::ms_unconstrained [ms] (the same steps' stage 2)
 //   in_step_ratio  sum ms_total / sum ms_unconstrained over the timed steps (the steps.csv ratio)
-//   sqp_mean, newton_mean, pgs_sweeps_mean, rows_mean  per step
+//   sqp_mean, newton_mean, pcg_mean (PCG iterations on kept factors and model steps),
+//   factorizations_mean (Newton matrices factored), pgs_sweeps_mean, rows_mean  per step
 //   unconverged    steps with StepStats::converged false; max_violation  max violation_after
 //   primal_share   islands solved by the primal path / islands solved
 //   height_change_mm (rest_box) |box z(2 s) - box z(1 s)|; max_drift_mm the largest |z - z(1 s)|.
@@ -194,7 +195,7 @@ void RunCase(benchmark::State& state, const Case& c, bool constrained, IslandSol
   double max_drift = 0.0;
   std::vector<double> cpu_ms, wall_ms, unc_ms;
   double sum_total = 0.0, sum_unc = 0.0, max_violation = 0.0;
-  long sqp = 0, newton = 0, sweeps = 0, rows = 0, unconverged = 0, dual = 0, primal = 0;
+  long sqp = 0, newton = 0, pcg = 0, factorizations = 0, sweeps = 0, rows = 0, unconverged = 0, dual = 0, primal = 0;
   for (auto _ : state) {
     const double t0 = ThreadCpuMs();
     world.stepSimulation(kDt, 1, kDt);
@@ -206,6 +207,8 @@ void RunCase(benchmark::State& state, const Case& c, bool constrained, IslandSol
     sum_unc += st.ms_unconstrained;
     sqp += st.sqp_iterations;
     newton += st.newton_iterations;
+    pcg += st.pcg_iterations;
+    factorizations += st.newton_factorizations;
     sweeps += st.pgs_sweeps;
     rows += st.rows_total();
     unconverged += st.converged ? 0 : 1;
@@ -224,6 +227,8 @@ void RunCase(benchmark::State& state, const Case& c, bool constrained, IslandSol
   state.counters["in_step_ratio"] = sum_unc > 0.0 ? sum_total / sum_unc : 0.0;
   state.counters["sqp_mean"] = sqp / steps;
   state.counters["newton_mean"] = newton / steps;
+  state.counters["pcg_mean"] = pcg / steps;
+  state.counters["factorizations_mean"] = factorizations / steps;
   state.counters["pgs_sweeps_mean"] = sweeps / steps;
   state.counters["rows_mean"] = rows / steps;
   state.counters["unconverged"] = static_cast<double>(unconverged);

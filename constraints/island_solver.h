@@ -113,11 +113,14 @@ class IslandSolver {
   void SolveDual(double h, const std::vector<IslandBody*>& bodies,
                  const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
                  StepStats& stats);
+  // After a dual step of an island with limit rows stalled as locally infeasible (kAuto): the
+  // primal window opens (State::primal), as after a dual failure of a limit-only island.
+  void OpenPrimalAfterStall(const StepStats& stats);
   // After a failed step (kAuto, retry_failed_step_on_other_path): the path `other` from the
   // step's start velocities (start_v_) and warm starts (a dual retry: `warm_start`, the step's
-  // own; a primal retry: the failed dual answer's multipliers), at most
-  // retry_max_iterations iterations; keeps the better answer. Returns whether the retry
-  // certified the step.
+  // own; a primal retry: the failed dual answer's multipliers), at most retry_max_iterations
+  // iterations; keeps the better answer (a dual retry that stalled as locally infeasible only
+  // when certified). Returns whether the retry certified the step.
   bool RetryOn(IslandSolverKind other, double h, const std::vector<IslandBody*>& bodies,
                const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
                KeyedMultipliers warm_start, StepStats& stats);

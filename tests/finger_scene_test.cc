@@ -149,8 +149,10 @@ TEST(FingerSceneTest, CertificateStepsCertifyTheHoldsBetweenPresses) {
     scene.world().mutable_solver_settings().certificate_steps = on != 0;
     // From the papers' start v* (the warm-start velocity starts the holds at their answer).
     scene.world().mutable_solver_settings().warm_start_velocity = false;
-    // The dual path's own figures: no second solve on the primal path for its failed steps.
+    // The dual path's own figures: no second solve on the primal path for its failed steps, and
+    // no primal steps after a locked advance stalled (kept here, not taken back).
     scene.world().mutable_solver_settings().retry_failed_step_on_other_path = false;
+    scene.world().mutable_solver_settings().solver = IslandSolverKind::kDual;
     for (int step = 0; step < 5000 && scene.current_press() < scene.num_presses(); ++step) {
       scene.Step(1e-3);
       const StepStats& stats = scene.world().last_step_stats();
