@@ -195,7 +195,8 @@ void RunCase(benchmark::State& state, const Case& c, bool constrained, IslandSol
   double max_drift = 0.0;
   std::vector<double> cpu_ms, wall_ms, unc_ms;
   double sum_total = 0.0, sum_unc = 0.0, max_violation = 0.0;
-  long sqp = 0, newton = 0, pcg = 0, factorizations = 0, sweeps = 0, rows = 0, unconverged = 0, dual = 0, primal = 0;
+  long sqp = 0, newton = 0, pcg = 0, factorizations = 0, sweeps = 0, rows = 0, unconverged = 0,
+       dual = 0, primal = 0;
   for (auto _ : state) {
     const double t0 = ThreadCpuMs();
     world.stepSimulation(kDt, 1, kDt);
