@@ -80,20 +80,7 @@ void IslandSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
       state_.no_retry.Open(kMaxStepsWithoutRetry);
     }
   }
-  if (infeasible && settings.solver == IslandSolverKind::kAuto) OpenPrimalAfterStall(stats);
   state_.last_rows = stats.rows_total();
-}
-
-void IslandSolver::OpenPrimalAfterStall(const StepStats& stats) {
-  // A limit row whose linearization holds only in a tiny neighbourhood (a sliver's principal
-  // stretch: curvature ~ 1/height^2) makes every dual step stall from v*, with the contacts left
-  // unresolved: the stress suite's sliver cubes (V/l^3 = 1e-6, 1e-9, +-5 % limits) sank 6 cm into
-  // the ground in 20 such steps, until a retry lifted them out at 11 m/s (energy growth 60x and
-  // 70x). The primal path holds their contacts (penetration 1.3 mm, no energy growth). A finger's
-  // locked advance also stalls, but the scene takes that step back, windows included.
-  if (stats.rows_strain + stats.rows_energy == 0) return;
-  state_.dual.left = 0;
-  state_.primal.Open(kMaxPrimalSteps);
 }
 
 void IslandSolver::SolveOn(IslandSolverKind kind, double h, const std::vector<IslandBody*>& bodies,
@@ -117,11 +104,24 @@ void IslandSolver::SolveDual(double h, const std::vector<IslandBody*>& bodies,
   // Measured failure of a limit-only island: the next steps go to the primal path (kAuto
   // only). Islands with contact or joint rows stay dual: there the primal path failed more
   // steps than the dual (finger: 46 vs 23 of 493, docs/report.md).
-  bool limit_rows_only = true;
-  for (const RowTypeInfo& info : kRowTypes)
-    if (!info.is_limit && stats.rows_of(info.type) > 0) limit_rows_only = false;
+  bool limit_rows_only = true, any_limit_row = false;
+  for (const RowTypeInfo& info : kRowTypes) {
+    if (stats.rows_of(info.type) == 0) continue;
+    if (info.is_limit)
+      any_limit_row = true;
+    else
+      limit_rows_only = false;
+  }
   const bool costly = stats.sqp_iterations > kCostlyDualSqpIterations;
-  if ((!stats.converged || costly) && limit_rows_only &&
+  // Except after a stall where no push lowers the violation, with limit rows: a row whose
+  // linearization holds only in a tiny neighbourhood (a sliver's principal stretch, curvature
+  // ~ 1/height^2) stalls every dual step from v* with the contacts left unresolved. The stress
+  // suite's sliver cubes (V/l^3 = 1e-6, 1e-9, +-5 % limits) sank 6 cm into the ground in 20 such
+  // steps, until a retry lifted them out at 11 m/s (energy growth 60x and 70x); the primal path
+  // holds their contacts (penetration 1.3 mm, no energy growth). A finger's locked advance also
+  // stalls, but the scene takes that step back, windows included.
+  const bool stalled_on_limits = dual_.stalled_infeasible() && any_limit_row;
+  if ((((!stats.converged || costly) && limit_rows_only) || stalled_on_limits) &&
       settings.solver == IslandSolverKind::kAuto) {
     state_.dual.left = 0;
     state_.primal.Open(kMaxPrimalSteps);
@@ -154,7 +154,7 @@ bool IslandSolver::RetryOn(IslandSolverKind other, double h, const std::vector<I
   SolveOn(other, h, bodies, sources, capped, retry);
   // A dual retry that stalled where no push lowers the violation leaves the contacts as v* had
   // them; by the certificate's error it still beat the primal answer of the sliver cubes
-  // (OpenPrimalAfterStall: 1.3 mm of penetration, growing 3 mm a step, against a sliver 2.8 %
+  // (SolveDual: 1.3 mm of penetration, growing 3 mm a step, against a sliver 2.8 %
   // past its limit), which sank again. Such a retry is kept only when certified.
   const bool stalled = other == IslandSolverKind::kDual && dual_.stalled_infeasible();
   if (retry.converged || (!stalled && CalcCertificateError(retry) < CalcCertificateError(stats))) {

@@ -109,13 +109,11 @@ class IslandSolver {
   void SolveOn(IslandSolverKind kind, double h, const std::vector<IslandBody*>& bodies,
                const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
                StepStats& stats);
-  // The dual path, with the failure rule of kAuto (the primal window).
+  // The dual path, with the failure rule of kAuto (the primal window: after a failed or costly
+  // step of a limit-only island, or a stall of an island with limit rows).
   void SolveDual(double h, const std::vector<IslandBody*>& bodies,
                  const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
                  StepStats& stats);
-  // After a dual step of an island with limit rows stalled as locally infeasible (kAuto): the
-  // primal window opens (State::primal), as after a dual failure of a limit-only island.
-  void OpenPrimalAfterStall(const StepStats& stats);
   // After a failed step (kAuto, retry_failed_step_on_other_path): the path `other` from the
   // step's start velocities (start_v_) and warm starts (a dual retry: `warm_start`, the step's
   // own; a primal retry: the failed dual answer's multipliers), at most retry_max_iterations

@@ -77,8 +77,9 @@ class ElementModel {
   virtual double CalcElementEnergy(int e, const VecX& x) const = 0;
   // Returns U_e [J] and sets forces[a] = f_e of node element_nodes(e)[a] [N] (R_e held).
   virtual double CalcElementForces(int e, const VecX& x, ElementVectors& forces) const = 0;
-  // The same, and *f_K_f = f_e^T K f_e with K = R_e K0_e R_e^T (CalcElementStiffness) from the
-  // same R_e: the stiffness along the forces (an energy-limit row's curvature along its Jacobian).
+  // The same, and (f_K_f not null) *f_K_f = f_e^T K f_e with K = R_e K0_e R_e^T
+  // (CalcElementStiffness) from the same R_e: the stiffness along the forces (an energy-limit
+  // row's curvature along its Jacobian).
   virtual double CalcElementForcesAndStiffnessAlong(int e, const VecX& x, ElementVectors& forces,
                                                     double* f_K_f) const = 0;
   // K = R_e K0_e R_e^T (3n x 3n for n = nodes_per_element(), symmetric PSD) [N/m].

@@ -272,11 +272,7 @@ double ElementModelImpl<Traits>::CalcElementEnergy(int e, const VecX& x) const {
 template <typename Traits>
 double ElementModelImpl<Traits>::CalcElementForces(int e, const VecX& x,
                                                    ElementVectors& forces) const {
-  const Nodes xe = GatherElement(x, e);
-  const typename Traits::Frame frame = Traits::CalcFrame(data_, e, xe);
-  const Nodes fe = Traits::CalcForces(data_, e, xe, frame);
-  for (int a = 0; a < kNodes; ++a) forces[a] = fe[a];
-  return Traits::CalcEnergy(data_, e, xe, frame);
+  return CalcElementForcesAndStiffnessAlong(e, x, forces, nullptr);
 }
 
 template <typename Traits>
@@ -286,16 +282,16 @@ double ElementModelImpl<Traits>::CalcElementForcesAndStiffnessAlong(int e, const
   const Nodes xe = GatherElement(x, e);
   const typename Traits::Frame frame = Traits::CalcFrame(data_, e, xe);
   const Nodes fe = Traits::CalcForces(data_, e, xe, frame);
-  // f^T R K0 R^T f = w^T K0 w with w_a = R^T f_a (K0 stored at rest).
-  Nodes w;
-  for (int a = 0; a < kNodes; ++a) {
-    forces[a] = fe[a];
-    w[a] = frame.R.transpose() * fe[a];
+  for (int a = 0; a < kNodes; ++a) forces[a] = fe[a];
+  if (f_K_f != nullptr) {
+    // f^T R K0 R^T f = w^T K0 w with w_a = R^T f_a (K0 stored at rest).
+    Nodes w;
+    for (int a = 0; a < kNodes; ++a) w[a] = frame.R.transpose() * fe[a];
+    const Nodes K0w = Traits::MultiplyRestStiffness(data_, e, w);
+    double sum = 0.0;
+    for (int a = 0; a < kNodes; ++a) sum += w[a].dot(K0w[a]);
+    *f_K_f = sum;
   }
-  const Nodes K0w = Traits::MultiplyRestStiffness(data_, e, w);
-  double sum = 0.0;
-  for (int a = 0; a < kNodes; ++a) sum += w[a].dot(K0w[a]);
-  *f_K_f = sum;
   return Traits::CalcEnergy(data_, e, xe, frame);
 }
 
