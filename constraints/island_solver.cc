@@ -89,6 +89,16 @@ void IslandSolver::SolveOn(IslandSolverKind kind, double h, const std::vector<Is
   if (kind == IslandSolverKind::kPrimal) {
     primal_.Solve(h, bodies, sources, settings, state_.warm, stats);
     solved_primal_ = true;
+    // Measured cost of a certified primal step on an island coupled to rigid bodies or
+    // multibodies (joint or rigid-contact rows: its Newton systems are solved by PCG): past
+    // kCostlyPrimalNewtonIterations the next steps go to the dual path (kAuto only).
+    const bool rigid_coupled =
+        stats.rows_of(RowType::kJoint) > 0 || stats.rows_of(RowType::kRigidContact) > 0;
+    if (settings.solver == IslandSolverKind::kAuto && stats.converged && rigid_coupled &&
+        stats.newton_iterations > kCostlyPrimalNewtonIterations) {
+      state_.primal.left = 0;
+      state_.dual.Open(kMaxDualSteps);
+    }
   } else {
     SolveDual(h, bodies, sources, settings, stats);
   }

@@ -107,6 +107,42 @@ KktResiduals CalcKktResiduals(const std::vector<IslandBody*>& bodies, const Isla
   return kkt;
 }
 
+namespace {
+
+// Relative band below the rim of a Coulomb disk within which a sliding pair's force counts as the
+// rim's (FitFrictionToCurrentDisks).
+constexpr double kRimBand = 1e-2;
+
+// lambda's friction pairs rescaled onto the rim of the disk of radius mu max(0, lambda_n) of
+// their normal multiplier: pairs outside it, and pairs sliding against their force (a row with
+// h |J_t v| above the tolerance in limit units) within kRimBand below it. Returns false when no
+// pair moved.
+bool FitFrictionToCurrentDisks(const IslandRows& rows, const std::vector<VecX>& v, double h,
+                               double distance_scale, double violation_tolerance, VecX& lambda) {
+  bool moved = false;
+  for (int c = 0; c < rows.size(); ++c) {
+    const ConstraintRow& row = rows[c];
+    if (row.friction_of != 1) continue;
+    const double radius = row.mu * std::max(0.0, lambda[c - 1]);
+    const double norm_t = std::hypot(lambda[c], lambda[c + 1]);
+    if (norm_t == radius || norm_t == 0.0) continue;
+    const double u1 = rows.CalcRowVelocity(c, v), u2 = rows.CalcRowVelocity(c + 1, v);
+    const double slip = h * std::max(std::abs(u1), std::abs(u2));
+    // Sliding near the rim, against the force (Coulomb: lambda_t opposes the slip velocity).
+    const bool sliding_near_rim = norm_t >= (1.0 - kRimBand) * radius &&
+                                  slip * distance_scale > violation_tolerance &&
+                                  lambda[c] * u1 + lambda[c + 1] * u2 < 0.0;
+    if (norm_t < radius && !sliding_near_rim) continue;
+    const double scale = radius / norm_t;
+    lambda[c] *= scale;
+    lambda[c + 1] *= scale;
+    moved = true;
+  }
+  return moved;
+}
+
+}  // namespace
+
 KktResiduals CalcKktResidualsWithRefit(const std::vector<IslandBody*>& bodies,
                                        const IslandRows& rows, const VecX& lambda,
                                        const std::vector<VecX>& v, double h, double distance_scale,
@@ -114,9 +150,19 @@ KktResiduals CalcKktResidualsWithRefit(const std::vector<IslandBody*>& bodies,
                                        VecX& scratch, VecX& certified) {
   certified = lambda;
   const KktResiduals kkt = CalcKktResiduals(bodies, rows, lambda, v, h, distance_scale, scratch);
-  if (IsCertified(kkt, violation_tolerance, stationarity_tolerance) ||
-      kkt.max_primal() > violation_tolerance || kkt.dual > 1e-6)
+  if (IsCertified(kkt, violation_tolerance, stationarity_tolerance)) return kkt;
+  // Friction forces just off the rims of their Coulomb disks (the primal path projects them onto
+  // the disks of the previous normal multipliers, which the update moves): the refit starts from
+  // the same forces on the rims of the current ones (docs/math.md §5.10).
+  KktResiduals start = kkt;
+  if (FitFrictionToCurrentDisks(rows, v, h, distance_scale, violation_tolerance, certified)) {
+    start = CalcKktResiduals(bodies, rows, certified, v, h, distance_scale, scratch);
+    if (IsCertified(start, violation_tolerance, stationarity_tolerance)) return start;
+  }
+  if (start.max_primal() > violation_tolerance || start.dual > 1e-6) {
+    certified = lambda;
     return kkt;
+  }
   // Aim below the tolerance: the refit stops once stationarity is surely within half of it.
   RefitLimitMultipliers(bodies, rows, v, violation_tolerance, 0.5 * stationarity_tolerance,
                         kRefitSweeps, certified);

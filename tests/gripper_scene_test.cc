@@ -78,13 +78,15 @@ TEST_P(GripperSceneTest, SqueezesTheStrainLimitedCubeAndLiftsItOffTheGround) {
   EXPECT_NEAR(hold_force[0].z() + hold_force[1].z(), weight, 0.01 * weight);
 }
 
-// On the auto path the gripper's island takes the primal path by its rows per DOF; at first
-// contact that path fails and the dual retry certifies the step. The island then stays on the
-// dual path (IslandSolver::kDualStepsAfterPrimalFailure) instead of failing again at 50-110 ms a
-// step, as it did the next steps before.
+// On the auto path the gripper's island takes the primal path by its rows per DOF. Capped at one
+// multiplier iteration, that path fails at first contact and the dual retry certifies the step.
+// The island then stays on the dual path (IslandSolver::kDualStepsAfterPrimalFailure) instead of
+// failing again, as it did at 50-110 ms a step before that rule (then uncapped: the primal path
+// failed there until its certificate fitted friction to the current Coulomb disks).
 TEST(GripperSceneAutoTest, AfterAPrimalFailureTheDualRetryCertifiedTheIslandStaysDual) {
   GripperScene scene;
   scene.mutable_solver_settings().solver = IslandSolverKind::kAuto;
+  scene.mutable_solver_settings().primal.max_iterations = 1;
   int step = 0;
   for (; step < kSteps; ++step) {
     scene.Step(kGripperStep);
@@ -98,6 +100,30 @@ TEST(GripperSceneAutoTest, AfterAPrimalFailureTheDualRetryCertifiedTheIslandStay
     const StepStats& stats = scene.last_step_stats();
     EXPECT_EQ(stats.islands_primal, 0) << "step " << step + 1 + next;
     EXPECT_EQ(stats.islands_retried, 0) << "step " << step + 1 + next;
+  }
+}
+
+// Uncapped, the gripper's primal steps certify but take about 9 Newton iterations each, where the
+// dual path is cheaper (docs/solver.md, "Two paths"): after the first such step the island goes to
+// the dual path (IslandSolver::kCostlyPrimalNewtonIterations), certified, for the next steps.
+TEST(GripperSceneAutoTest, ACostlyCertifiedPrimalStepSendsTheIslandToTheDualPath) {
+  GripperScene scene;
+  scene.mutable_solver_settings().solver = IslandSolverKind::kAuto;
+  int step = 0;
+  for (; step < kSteps; ++step) {
+    scene.Step(kGripperStep);
+    const StepStats& stats = scene.last_step_stats();
+    if (stats.islands_primal > 0 && stats.converged &&
+        stats.newton_iterations > IslandSolver::kCostlyPrimalNewtonIterations)
+      break;
+  }
+  std::printf("first costly certified primal step: %d\n", step);
+  ASSERT_LT(step, kSteps) << "no primal step took more than the costly count";
+  for (int next = 0; next < 10; ++next) {
+    scene.Step(kGripperStep);
+    const StepStats& stats = scene.last_step_stats();
+    EXPECT_EQ(stats.islands_primal, 0) << "step " << step + 1 + next;
+    EXPECT_TRUE(stats.converged) << "step " << step + 1 + next;
   }
 }
 

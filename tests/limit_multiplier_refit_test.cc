@@ -2,7 +2,9 @@
 // certificate that uses them (CalcKktResidualsWithRefit, docs/math.md §5.10): with redundant rows
 // the force may sit on a row short of its bound while another row at its bound could carry it;
 // the certificate then holds for the refitted multipliers. A slack row that alone holds the body
-// is not released into a certificate.
+// is not released into a certificate. Friction forces just outside their Coulomb disks (an
+// augmented-Lagrangian update projects onto the disk of the previous normal multiplier) are
+// certified projected onto the current disks when that keeps the step stationary.
 #include "constraints/limit_multiplier_refit.h"
 
 #include <gtest/gtest.h>
@@ -95,6 +97,111 @@ struct RefitIsland {
                                      scratch, certified);
   }
 };
+
+// One frictional contact of a point mass on the ground z = 0 (rows n = +z, t1 = +x, t2 = +y).
+class RefitGroundContact final : public ConstraintSource {
+ public:
+  explicit RefitGroundContact(double mu) : mu_(mu) {}
+  int AppendIslandRows(const IslandIterate&, std::vector<ConstraintRow>& rows) override {
+    const Vec3 directions[3] = {Vec3(0, 0, 1), Vec3(1, 0, 0), Vec3(0, 1, 0)};
+    for (int r = 0; r < 3; ++r) {
+      ConstraintRow& row = rows.emplace_back();
+      row.type = RowType::kContact;
+      row.key = r;
+      row.C = 0.0;
+      row.friction_of = r;
+      row.mu = r > 0 ? mu_ : 0.0;
+      row.body = 0;
+      row.num_nodes = 1;
+      row.nodes[0] = 0;
+      row.J[0] = directions[r];
+    }
+    return 3;
+  }
+  double CalcIslandViolationSum(const IslandIterate&) const override { return 0.0; }
+
+ private:
+  double mu_;
+};
+
+// A 1 kg mass sticking on the ground (v = 0) with v* = (-0.5, 0, -1): A (v - v*) = (0.5, 0, 1)
+// is held by lambda_n = 1 and friction (0.5, 0), on the rim of the mu = 0.5 disk.
+struct RefitContactIsland {
+  RefitPointMasses body{1, 1.0};
+  RefitGroundContact source{0.5};
+  std::vector<IslandBody*> bodies{&body};
+  IslandRows rows;
+  std::vector<VecX> v{VecX::Zero(3)};
+  RefitContactIsland() {
+    body.set_v_star(Vec3(-0.5, 0, -1));
+    std::vector<ConstraintSource*> sources{&source};
+    rows.Collect(kRefitH, bodies, sources, v, 1.0);
+  }
+  KktResiduals ResidualsWithRefit(const VecX& lambda, VecX& certified) {
+    VecX scratch;
+    return CalcKktResidualsWithRefit(bodies, rows, lambda, v, kRefitH, 1.0, kRefitTolerance, 1e-2,
+                                     scratch, certified);
+  }
+};
+
+// Friction 2e-5 outside the disk (dual residual 2e-5 > 1e-6): projected onto the disk it is the
+// exact force, certified.
+TEST(LimitMultiplierRefitTest, FrictionJustOutsideItsDiskIsCertifiedOnTheDisk) {
+  RefitContactIsland island;
+  const VecX lambda = (VecX(3) << 1.0, 0.50002, 0.0).finished();
+  VecX scratch;
+  const KktResiduals plain =
+      CalcKktResiduals(island.bodies, island.rows, lambda, island.v, kRefitH, 1.0, scratch);
+  EXPECT_NEAR(plain.dual, 2e-5, 1e-12);
+  EXPECT_FALSE(IsCertified(plain, kRefitTolerance, 1e-2));
+  VecX certified;
+  const KktResiduals kkt = island.ResidualsWithRefit(lambda, certified);
+  EXPECT_TRUE(IsCertified(kkt, kRefitTolerance, 1e-2));
+  EXPECT_LE(kkt.dual, 1e-15);
+  EXPECT_NEAR(certified[1], 0.5, 1e-15);  // on the rim mu lambda_n
+  EXPECT_EQ(certified[0], 1.0);
+  EXPECT_LT(kkt.stationarity, 1e-12);
+}
+
+// Friction far outside the disk (0.8 against 0.5): on the disk it leaves 0.3 of the force
+// unbalanced, so nothing is certified and the solver's multipliers stay.
+TEST(LimitMultiplierRefitTest, FrictionFarOutsideItsDiskIsNotProjectedIntoACertificate) {
+  RefitContactIsland island;
+  island.body.set_v_star(Vec3(-0.8, 0, -1));
+  const VecX lambda = (VecX(3) << 1.0, 0.8, 0.0).finished();
+  VecX certified;
+  const KktResiduals kkt = island.ResidualsWithRefit(lambda, certified);
+  EXPECT_FALSE(IsCertified(kkt, kRefitTolerance, 1e-2));
+  EXPECT_EQ(certified, lambda);
+  EXPECT_NEAR(kkt.dual, 0.3 / 1.0, 1e-12);
+}
+
+// The mass sliding along -x at 1 m/s (v* = (-1.5, 0, -1), so A (v - v*) = (0.5, 0, 1)) with
+// friction 1e-4 short of the rim: inside the disk yet sliding fails complementarity; on the rim,
+// opposing the slip, the same force is Coulomb's and is certified. Friction pushing along the slip
+// is not moved onto the rim.
+TEST(LimitMultiplierRefitTest, FrictionJustInsideItsDiskWhileSlidingIsCertifiedOnTheRim) {
+  RefitContactIsland island;
+  island.body.set_v_star(Vec3(-1.5, 0, -1));
+  island.v[0] = Vec3(-1.0, 0, 0);
+  const VecX lambda = (VecX(3) << 1.0, 0.4999, 0.0).finished();
+  VecX scratch;
+  const KktResiduals plain =
+      CalcKktResiduals(island.bodies, island.rows, lambda, island.v, kRefitH, 1.0, scratch);
+  EXPECT_NEAR(plain.max_complementarity(), kRefitH * 1.0, 1e-15);
+  EXPECT_FALSE(IsCertified(plain, kRefitTolerance, 1e-2));
+  VecX certified;
+  const KktResiduals kkt = island.ResidualsWithRefit(lambda, certified);
+  EXPECT_TRUE(IsCertified(kkt, kRefitTolerance, 1e-2));
+  EXPECT_EQ(kkt.max_complementarity(), 0.0);
+  EXPECT_NEAR(certified[1], 0.5, 1e-15);
+
+  island.v[0] = Vec3(1.0, 0, 0);  // sliding along +x, with the force
+  island.body.set_v_star(Vec3(0.5, 0, -1));
+  const KktResiduals along = island.ResidualsWithRefit(lambda, certified);
+  EXPECT_FALSE(IsCertified(along, kRefitTolerance, 1e-2));
+  EXPECT_EQ(certified, lambda);
+}
 
 // A 2 kg mass at rest (v = 0) whose target velocity v* = (0, 0, -1) is held by two rows along +z:
 // row 0 at its bound (C = 0), row 1 short of it (C = 5e-3). The force A (v - v*) = (0, 0, 2)
