@@ -114,9 +114,9 @@ namespace {
 constexpr double kRimBand = 1e-2;
 
 // lambda's friction pairs rescaled onto the rim of the disk of radius mu max(0, lambda_n) of
-// their normal multiplier: pairs outside it, and pairs sliding against their force (a row with
-// h |J_t v| above the tolerance in limit units) within kRimBand below it. Returns false when no
-// pair moved.
+// their normal multiplier: pairs outside it, and pairs sliding (a row with h |J_t v| above the
+// tolerance in limit units) within kRimBand below it; a sliding pair only if its force opposes its
+// slip. Returns false when no pair moved.
 bool FitFrictionToCurrentDisks(const IslandRows& rows, const std::vector<VecX>& v, double h,
                                double distance_scale, double violation_tolerance, VecX& lambda) {
   bool moved = false;
@@ -128,11 +128,11 @@ bool FitFrictionToCurrentDisks(const IslandRows& rows, const std::vector<VecX>& 
     if (norm_t == radius || norm_t == 0.0) continue;
     const double u1 = rows.CalcRowVelocity(c, v), u2 = rows.CalcRowVelocity(c + 1, v);
     const double slip = h * std::max(std::abs(u1), std::abs(u2));
-    // Sliding near the rim, against the force (Coulomb: lambda_t opposes the slip velocity).
-    const bool sliding_near_rim = norm_t >= (1.0 - kRimBand) * radius &&
-                                  slip * distance_scale > violation_tolerance &&
-                                  lambda[c] * u1 + lambda[c + 1] * u2 < 0.0;
-    if (norm_t < radius && !sliding_near_rim) continue;
+    // On the rim a sliding contact's force must oppose its slip (Coulomb's direction); inside
+    // the disk only a sliding pair within kRimBand of the rim moves onto it.
+    const bool sliding = slip * distance_scale > violation_tolerance;
+    if (sliding && !(lambda[c] * u1 + lambda[c + 1] * u2 < 0.0)) continue;
+    if (norm_t < radius && !(sliding && norm_t >= (1.0 - kRimBand) * radius)) continue;
     const double scale = radius / norm_t;
     lambda[c] *= scale;
     lambda[c + 1] *= scale;

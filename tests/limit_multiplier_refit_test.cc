@@ -145,7 +145,7 @@ struct RefitContactIsland {
 };
 
 // Friction 2e-5 outside the disk (dual residual 2e-5 > 1e-6): projected onto the disk it is the
-// exact force, certified.
+// exact force, certified; sliding with the force it is not.
 TEST(LimitMultiplierRefitTest, FrictionJustOutsideItsDiskIsCertifiedOnTheDisk) {
   RefitContactIsland island;
   const VecX lambda = (VecX(3) << 1.0, 0.50002, 0.0).finished();
@@ -161,6 +161,13 @@ TEST(LimitMultiplierRefitTest, FrictionJustOutsideItsDiskIsCertifiedOnTheDisk) {
   EXPECT_NEAR(certified[1], 0.5, 1e-15);  // on the rim mu lambda_n
   EXPECT_EQ(certified[0], 1.0);
   EXPECT_LT(kkt.stationarity, 1e-12);
+
+  // Sliding along +x, with the force: not Coulomb on the rim, so not moved there.
+  island.v[0] = Vec3(1.0, 0, 0);
+  island.body.set_v_star(Vec3(0.5, 0, -1));
+  const KktResiduals along = island.ResidualsWithRefit(lambda, certified);
+  EXPECT_FALSE(IsCertified(along, kRefitTolerance, 1e-2));
+  EXPECT_EQ(certified, lambda);
 }
 
 // Friction far outside the disk (0.8 against 0.5): on the disk it leaves 0.3 of the force
