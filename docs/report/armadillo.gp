@@ -37,6 +37,32 @@ plot \
   '' skip 1 using (strcol(1) eq 'dt' && strcol(3) eq 'primal' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($24 - 0) > 0 ? ($24 - 0) : NaN) with linespoints lw 1.5 ps 0.6 dt 2 pt 5 lc rgb '#d01c8b' title 'time step, primal', \
   '' skip 1 using (strcol(1) eq 'dt' && strcol(3) eq 'primal' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($24 - 0) > 0 ? ($24 - 0) : NaN):(strcol(2)) with labels offset char 0.8,0.5 font ',7' tc rgb '#d01c8b' notitle
 unset key
+set ylabel 'max U_e/U_max - 1'
+plot \
+  'armadillo.csv' skip 1 using (strcol(1) eq 'default' && strcol(3) eq 'dual' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($25 - 1) > 0 ? ($25 - 1) : NaN) with points lw 1.5 ps 1.4 dt 1 pt 6 lc rgb '#000000' title 'default settings, dual', \
+  '' skip 1 using (strcol(1) eq 'default' && strcol(3) eq 'dual' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($25 - 1) > 0 ? ($25 - 1) : NaN):(strcol(2)) with labels offset char 0.8,0.5 font ',7' tc rgb '#000000' notitle, \
+  '' skip 1 using (strcol(1) eq 'default' && strcol(3) eq 'primal' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($25 - 1) > 0 ? ($25 - 1) : NaN) with points lw 1.5 ps 1.4 dt 2 pt 4 lc rgb '#000000' title 'default settings, primal', \
+  '' skip 1 using (strcol(1) eq 'default' && strcol(3) eq 'primal' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($25 - 1) > 0 ? ($25 - 1) : NaN):(strcol(2)) with labels offset char 0.8,0.5 font ',7' tc rgb '#000000' notitle, \
+  '' skip 1 using (strcol(1) eq 'default' && strcol(3) eq 'auto' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($25 - 1) > 0 ? ($25 - 1) : NaN) with points lw 1.5 ps 1.4 dt 3 pt 8 lc rgb '#000000' title 'default settings, auto', \
+  '' skip 1 using (strcol(1) eq 'default' && strcol(3) eq 'auto' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($25 - 1) > 0 ? ($25 - 1) : NaN):(strcol(2)) with labels offset char 0.8,0.5 font ',7' tc rgb '#000000' notitle, \
+  '' skip 1 using (strcol(1) eq 'pgs' && strcol(3) eq 'dual' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($25 - 1) > 0 ? ($25 - 1) : NaN) with linespoints lw 1.5 ps 0.6 dt 1 pt 7 lc rgb '#7b3294' title 'PGS sweep cap, dual', \
+  '' skip 1 using (strcol(1) eq 'pgs' && strcol(3) eq 'dual' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($25 - 1) > 0 ? ($25 - 1) : NaN):(strcol(2)) with labels offset char 0.8,0.5 font ',7' tc rgb '#7b3294' notitle, \
+  '' skip 1 using (strcol(1) eq 'newton' && strcol(3) eq 'primal' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($25 - 1) > 0 ? ($25 - 1) : NaN) with linespoints lw 1.5 ps 0.6 dt 2 pt 5 lc rgb '#1b9e77' title 'Newton cap, primal', \
+  '' skip 1 using (strcol(1) eq 'newton' && strcol(3) eq 'primal' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($25 - 1) > 0 ? ($25 - 1) : NaN):(strcol(2)) with labels offset char 0.8,0.5 font ',7' tc rgb '#1b9e77' notitle, \
+  '' skip 1 using (strcol(1) eq 'penalty' && strcol(3) eq 'primal' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($25 - 1) > 0 ? ($25 - 1) : NaN) with linespoints lw 1.5 ps 0.6 dt 2 pt 5 lc rgb '#a6611a' title 'penalty scale, primal', \
+  '' skip 1 using (strcol(1) eq 'penalty' && strcol(3) eq 'primal' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($25 - 1) > 0 ? ($25 - 1) : NaN):(strcol(2)) with labels offset char 0.8,0.5 font ',7' tc rgb '#a6611a' notitle, \
+  '' skip 1 using (strcol(1) eq 'sqp' && strcol(3) eq 'dual' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($25 - 1) > 0 ? ($25 - 1) : NaN) with linespoints lw 1.5 ps 0.6 dt 1 pt 7 lc rgb '#e66101' title 'SQP iteration cap, dual', \
+  '' skip 1 using (strcol(1) eq 'sqp' && strcol(3) eq 'dual' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($25 - 1) > 0 ? ($25 - 1) : NaN):(strcol(2)) with labels offset char 0.8,0.5 font ',7' tc rgb '#e66101' notitle, \
+  '' skip 1 using (strcol(1) eq 'sqp' && strcol(3) eq 'primal' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($25 - 1) > 0 ? ($25 - 1) : NaN) with linespoints lw 1.5 ps 0.6 dt 2 pt 5 lc rgb '#e66101' title 'SQP iteration cap, primal', \
+  '' skip 1 using (strcol(1) eq 'sqp' && strcol(3) eq 'primal' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($25 - 1) > 0 ? ($25 - 1) : NaN):(strcol(2)) with labels offset char 0.8,0.5 font ',7' tc rgb '#e66101' notitle, \
+  '' skip 1 using (strcol(1) eq 'tol' && strcol(3) eq 'dual' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($25 - 1) > 0 ? ($25 - 1) : NaN) with linespoints lw 1.5 ps 0.6 dt 1 pt 7 lc rgb '#0571b0' title 'SQP tolerance, dual', \
+  '' skip 1 using (strcol(1) eq 'tol' && strcol(3) eq 'dual' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($25 - 1) > 0 ? ($25 - 1) : NaN):(strcol(2)) with labels offset char 0.8,0.5 font ',7' tc rgb '#0571b0' notitle, \
+  '' skip 1 using (strcol(1) eq 'tol' && strcol(3) eq 'primal' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($25 - 1) > 0 ? ($25 - 1) : NaN) with linespoints lw 1.5 ps 0.6 dt 2 pt 5 lc rgb '#0571b0' title 'SQP tolerance, primal', \
+  '' skip 1 using (strcol(1) eq 'tol' && strcol(3) eq 'primal' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($25 - 1) > 0 ? ($25 - 1) : NaN):(strcol(2)) with labels offset char 0.8,0.5 font ',7' tc rgb '#0571b0' notitle, \
+  '' skip 1 using (strcol(1) eq 'dt' && strcol(3) eq 'dual' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($25 - 1) > 0 ? ($25 - 1) : NaN) with linespoints lw 1.5 ps 0.6 dt 1 pt 7 lc rgb '#d01c8b' title 'time step, dual', \
+  '' skip 1 using (strcol(1) eq 'dt' && strcol(3) eq 'dual' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($25 - 1) > 0 ? ($25 - 1) : NaN):(strcol(2)) with labels offset char 0.8,0.5 font ',7' tc rgb '#d01c8b' notitle, \
+  '' skip 1 using (strcol(1) eq 'dt' && strcol(3) eq 'primal' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($25 - 1) > 0 ? ($25 - 1) : NaN) with linespoints lw 1.5 ps 0.6 dt 2 pt 5 lc rgb '#d01c8b' title 'time step, primal', \
+  '' skip 1 using (strcol(1) eq 'dt' && strcol(3) eq 'primal' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($25 - 1) > 0 ? ($25 - 1) : NaN):(strcol(2)) with labels offset char 0.8,0.5 font ',7' tc rgb '#d01c8b' notitle
 set ylabel 'max penetration [m]'
 plot \
   'armadillo.csv' skip 1 using (strcol(1) eq 'default' && strcol(3) eq 'dual' && strstrt(strcol(35), 'failed') != 1 ? $16 : NaN):(($26 - 0) > 0 ? ($26 - 0) : NaN) with points lw 1.5 ps 1.4 dt 1 pt 6 lc rgb '#000000' title 'default settings, dual', \
