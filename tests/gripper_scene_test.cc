@@ -78,6 +78,28 @@ TEST_P(GripperSceneTest, SqueezesTheStrainLimitedCubeAndLiftsItOffTheGround) {
   EXPECT_NEAR(hold_force[0].z() + hold_force[1].z(), weight, 0.01 * weight);
 }
 
+// Steps `scene` until `stop(stats)` holds; returns that step's index (kSteps if none did).
+template <typename Stop>
+int StepUntil(GripperScene& scene, Stop stop) {
+  int step = 0;
+  for (; step < kSteps; ++step) {
+    scene.Step(kGripperStep);
+    if (stop(scene.last_step_stats())) break;
+  }
+  return step;
+}
+
+// The next `count` steps after `step` are certified on the dual path, without retries.
+void ExpectDualSteps(GripperScene& scene, int step, int count) {
+  for (int next = 0; next < count; ++next) {
+    scene.Step(kGripperStep);
+    const StepStats& stats = scene.last_step_stats();
+    EXPECT_EQ(stats.islands_primal, 0) << "step " << step + 1 + next;
+    EXPECT_EQ(stats.islands_retried, 0) << "step " << step + 1 + next;
+    EXPECT_TRUE(stats.converged) << "step " << step + 1 + next;
+  }
+}
+
 // On the auto path the gripper's island takes the primal path by its rows per DOF. Capped at one
 // multiplier iteration, that path fails at first contact and the dual retry certifies the step.
 // The island then stays on the dual path (IslandSolver::kDualStepsAfterPrimalFailure) instead of
@@ -87,20 +109,12 @@ TEST(GripperSceneAutoTest, AfterAPrimalFailureTheDualRetryCertifiedTheIslandStay
   GripperScene scene;
   scene.mutable_solver_settings().solver = IslandSolverKind::kAuto;
   scene.mutable_solver_settings().primal.max_iterations = 1;
-  int step = 0;
-  for (; step < kSteps; ++step) {
-    scene.Step(kGripperStep);
-    const StepStats& stats = scene.last_step_stats();
-    if (stats.islands_retried > 0 && stats.islands_dual > 0 && stats.converged) break;
-  }
+  const int step = StepUntil(scene, [](const StepStats& stats) {
+    return stats.islands_retried > 0 && stats.islands_dual > 0 && stats.converged;
+  });
   std::printf("first primal failure certified by the dual retry at step %d\n", step);
   ASSERT_LT(step, kSteps) << "no step was retried onto the dual path";
-  for (int next = 0; next < 10; ++next) {
-    scene.Step(kGripperStep);
-    const StepStats& stats = scene.last_step_stats();
-    EXPECT_EQ(stats.islands_primal, 0) << "step " << step + 1 + next;
-    EXPECT_EQ(stats.islands_retried, 0) << "step " << step + 1 + next;
-  }
+  ExpectDualSteps(scene, step, 10);
 }
 
 // Uncapped, the gripper's primal steps certify but take about 9 Newton iterations each, where the
@@ -109,22 +123,13 @@ TEST(GripperSceneAutoTest, AfterAPrimalFailureTheDualRetryCertifiedTheIslandStay
 TEST(GripperSceneAutoTest, ACostlyCertifiedPrimalStepSendsTheIslandToTheDualPath) {
   GripperScene scene;
   scene.mutable_solver_settings().solver = IslandSolverKind::kAuto;
-  int step = 0;
-  for (; step < kSteps; ++step) {
-    scene.Step(kGripperStep);
-    const StepStats& stats = scene.last_step_stats();
-    if (stats.islands_primal > 0 && stats.converged &&
-        stats.newton_iterations > IslandSolver::kCostlyPrimalNewtonIterations)
-      break;
-  }
+  const int step = StepUntil(scene, [](const StepStats& stats) {
+    return stats.islands_primal > 0 && stats.converged &&
+           stats.newton_iterations > IslandSolver::kCostlyPrimalNewtonIterations;
+  });
   std::printf("first costly certified primal step: %d\n", step);
   ASSERT_LT(step, kSteps) << "no primal step took more than the costly count";
-  for (int next = 0; next < 10; ++next) {
-    scene.Step(kGripperStep);
-    const StepStats& stats = scene.last_step_stats();
-    EXPECT_EQ(stats.islands_primal, 0) << "step " << step + 1 + next;
-    EXPECT_TRUE(stats.converged) << "step " << step + 1 + next;
-  }
+  ExpectDualSteps(scene, step, 10);
 }
 
 INSTANTIATE_TEST_SUITE_P(BothPaths, GripperSceneTest,
