@@ -64,8 +64,9 @@ class PrimalSolver {
   bool MoveToUnconstrainedVelocity(double h, const std::vector<IslandBody*>& bodies,
                                    const std::vector<ConstraintSource*>& sources,
                                    const SqpSettings& settings, StepStats& stats);
-  // Stage: the start of the Newton iterations, the candidate velocity of least Phi (v*, the warm
-  // start below, the step-start velocity); leaves its rows collected.
+  // Stage: the start of the Newton iterations, the candidate velocity of least Phi (v*, the
+  // step-start velocity, the warm start below when Phi of the rows of v* linearized there ranks
+  // it first); leaves its rows collected.
   void ChooseStartVelocities(double h, const std::vector<IslandBody*>& bodies,
                              const std::vector<ConstraintSource*>& sources,
                              const SqpSettings& settings, StepStats& stats);
@@ -183,6 +184,7 @@ class PrimalSolver {
   RowGroup group_;
   std::vector<VecX> v_, v_trial_, d_, grad_, work_, r_, z_, p_, hp_;
   std::vector<VecX> w_, aw_;  // v - v* and A (v - v*) at the Newton iterate (CalcGradient)
+  std::vector<VecX> warm_v_;  // the warm-start candidate (ChooseStartVelocities)
   // The rows and velocities of the line search's base point (restored when no trial is taken).
   struct BasePoint {
     IslandRows rows;

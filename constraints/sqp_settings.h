@@ -44,6 +44,10 @@ struct PrimalSettings {
   int max_model_steps = 2;
   double model_step_alpha = 0.5;
   int model_pcg_iterations = 10;
+  // The warm-start candidate v* + A^-1 J^T lambda_bar of the step's start is collected (its rows,
+  // an SVD per element near its limits) only when Phi of the rows of v*, linearized there, ranks
+  // it below the other candidates (false: always; docs/math.md §5.8, the start).
+  bool screen_warm_start = true;
   // Factor reuse: a body whose H costs more than min_refactor_cost preconditioned CG iterations
   // to factor keeps its last factor (from an earlier Newton iteration or step) as the
   // preconditioner of CG on the exact H, to stale_pcg_tolerance, while CG needs fewer than half
