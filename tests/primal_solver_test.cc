@@ -273,71 +273,68 @@ TEST(PrimalSolverTest, FrameCurvatureHalvesTheAnisotropicBeamsNewtonIterations) 
   EXPECT_LT(newton[1], 0.75 * newton[0]);
 }
 
-TEST(PrimalSolverTest, ModelStepsCutTheIsotropicBeamsNewtonIterationsAndKeepItsPath) {
-  // The soft isotropic beam (240 tets, ellipsoid rows of equal limits: exact curvature). Where the
-  // model line search stops short because a row turns active along d, Newton steps on the same
-  // linearization replace full Newton iterations (rows, curvature and certificate evaluated
-  // again); the answer is the same certified one, so the tip follows the same path.
-  int newton[2] = {0, 0}, unconverged[2] = {0, 0};
-  double worst[2] = {0.0, 0.0};
-  Vec3 tip[2];
-  for (const int model : {0, 1}) {
-    TetBeamScene scene({TetBeamScene::DefaultBeams()[3]});
-    SqpSettings& settings = scene.world().mutable_solver_settings();
-    settings.solver = IslandSolverKind::kPrimal;
-    ASSERT_GT(settings.primal.max_model_steps, 0);  // on by default
-    if (model == 0) settings.primal.max_model_steps = 0;
-    for (int step = 0; step < 120; ++step) {
-      scene.world().stepSimulation(1.0 / 240.0, 1, 1.0 / 240.0);
-      const StepStats& stats = scene.world().last_step_stats();
-      newton[model] += stats.newton_iterations;
-      unconverged[model] += stats.converged ? 0 : 1;
-      worst[model] = std::max(worst[model], stats.violation_after);
-    }
-    tip[model] = scene.CalcTipDisplacement(0);
+// 120 primal steps of the soft isotropic beam (240 tets, ellipsoid rows of equal limits: exact
+// curvature) with its primal settings changed by `configure`: summed Newton iterations,
+// unconverged steps, the largest violation after a step and the tip displacement at the end.
+struct IsotropicBeamRun {
+  int newton = 0, unconverged = 0;
+  double worst = 0.0;
+  Vec3 tip = Vec3::Zero();
+};
+template <typename Configure>
+IsotropicBeamRun RunIsotropicBeamOnThePrimalPath(Configure configure) {
+  TetBeamScene scene({TetBeamScene::DefaultBeams()[3]});
+  SqpSettings& settings = scene.world().mutable_solver_settings();
+  settings.solver = IslandSolverKind::kPrimal;
+  configure(settings.primal);
+  IsotropicBeamRun run;
+  for (int step = 0; step < 120; ++step) {
+    scene.world().stepSimulation(1.0 / 240.0, 1, 1.0 / 240.0);
+    const StepStats& stats = scene.world().last_step_stats();
+    run.newton += stats.newton_iterations;
+    run.unconverged += stats.converged ? 0 : 1;
+    run.worst = std::max(run.worst, stats.violation_after);
   }
-  const double tip_gap = (tip[1] - tip[0]).norm();
+  run.tip = scene.CalcTipDisplacement(0);
+  return run;
+}
+
+TEST(PrimalSolverTest, ModelStepsCutTheIsotropicBeamsNewtonIterationsAndKeepItsPath) {
+  // Where the model line search stops short because a row turns active along d, Newton steps on
+  // the same linearization replace full Newton iterations (rows, curvature and certificate
+  // evaluated again); the answer is the same certified one, so the tip follows the same path.
+  ASSERT_GT(PrimalSettings().max_model_steps, 0);  // on by default
+  const IsotropicBeamRun plain =
+      RunIsotropicBeamOnThePrimalPath([](PrimalSettings& primal) { primal.max_model_steps = 0; });
+  const IsotropicBeamRun model = RunIsotropicBeamOnThePrimalPath([](PrimalSettings&) {});
+  const double tip_gap = (model.tip - plain.tip).norm();
   std::printf(
       "120 steps, Newton iterations: plain %d, with model steps %d; tip gap %.3g m (tip "
       "displacement %.3g m)\n",
-      newton[0], newton[1], tip_gap, tip[0].norm());
-  EXPECT_EQ(unconverged[0], 0);
-  EXPECT_EQ(unconverged[1], 0);
-  EXPECT_LE(worst[1], 1e-3);
-  EXPECT_LT(newton[1], 0.8 * newton[0]);
-  EXPECT_LT(tip_gap, 0.01 * tip[0].norm());
+      plain.newton, model.newton, tip_gap, plain.tip.norm());
+  EXPECT_EQ(plain.unconverged, 0);
+  EXPECT_EQ(model.unconverged, 0);
+  EXPECT_LE(model.worst, 1e-3);
+  EXPECT_LT(model.newton, 0.8 * plain.newton);
+  EXPECT_LT(tip_gap, 0.01 * plain.tip.norm());
 }
 
 TEST(PrimalSolverTest, ScreenedWarmStartKeepsTheIsotropicBeamsPath) {
   // The warm-start candidate's rows are collected only when Phi of the rows of v* linearized there
   // ranks it first (PrimalSettings::screen_warm_start): a start it skips was not the best, so
   // every step stays certified with the Newton iterations and the tip path of the full set.
-  int newton[2] = {0, 0}, unconverged[2] = {0, 0};
-  double worst[2] = {0.0, 0.0};
-  Vec3 tip[2];
-  for (const int screen : {0, 1}) {
-    TetBeamScene scene({TetBeamScene::DefaultBeams()[3]});
-    SqpSettings& settings = scene.world().mutable_solver_settings();
-    settings.solver = IslandSolverKind::kPrimal;
-    ASSERT_TRUE(settings.primal.screen_warm_start);  // on by default
-    settings.primal.screen_warm_start = screen == 1;
-    for (int step = 0; step < 120; ++step) {
-      scene.world().stepSimulation(1.0 / 240.0, 1, 1.0 / 240.0);
-      const StepStats& stats = scene.world().last_step_stats();
-      newton[screen] += stats.newton_iterations;
-      unconverged[screen] += stats.converged ? 0 : 1;
-      worst[screen] = std::max(worst[screen], stats.violation_after);
-    }
-    tip[screen] = scene.CalcTipDisplacement(0);
-  }
-  const double tip_gap = (tip[1] - tip[0]).norm();
+  ASSERT_TRUE(PrimalSettings().screen_warm_start);  // on by default
+  const IsotropicBeamRun all = RunIsotropicBeamOnThePrimalPath(
+      [](PrimalSettings& primal) { primal.screen_warm_start = false; });
+  const IsotropicBeamRun screened = RunIsotropicBeamOnThePrimalPath([](PrimalSettings&) {});
+  const double tip_gap = (screened.tip - all.tip).norm();
   std::printf("120 steps, Newton iterations: all candidates %d, screened %d; tip gap %.3g m\n",
-              newton[0], newton[1], tip_gap);
-  EXPECT_EQ(unconverged[0], 0);
-  EXPECT_EQ(unconverged[1], 0);
-  EXPECT_LE(worst[1], 1e-3);
-  EXPECT_LE(newton[1], newton[0] + newton[0] / 20);
-  EXPECT_LT(tip_gap, 0.01 * tip[0].norm());
+              all.newton, screened.newton, tip_gap);
+  EXPECT_EQ(all.unconverged, 0);
+  EXPECT_EQ(screened.unconverged, 0);
+  EXPECT_LE(screened.worst, 1e-3);
+  EXPECT_LE(screened.newton, all.newton + all.newton / 20);
+  EXPECT_LT(tip_gap, 0.01 * all.tip.norm());
 }
 
 TEST(PrimalSolverTest, SlackPushingRowsGetLargerPenaltiesAndConverge) {
