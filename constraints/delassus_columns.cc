@@ -2,32 +2,26 @@
 
 #include <algorithm>
 
+#include "plugin/dense_kernels.h"
+
 namespace taut {
 namespace {
 
-// Depth of one dense product below. Eigen splits a product's depth k into blocks of a size it
-// derives from the CPU's L1 cache (at least ~500 for double with a 32 KB L1) and sums the blocks'
-// partial results, so a deeper product's last bits would depend on the machine. Chunks of this
-// depth are summed here in a fixed order instead: the same bits on every CPU (determinism pins).
-constexpr Eigen::Index kProductDepthChunk = 256;
-
-// out = a^T b (a: d x m, b: d x k), the depth d summed in chunks of kProductDepthChunk.
+// out = a^T b (a: d x m, b: d x k), the depth summed in fixed chunks (plugin/dense_kernels.h).
 void MultiplyTransposedByChunks(const MatX& a, const MatX& b, MatX& out) {
-  out.setZero(a.cols(), b.cols());
-  for (Eigen::Index r = 0; r < a.rows(); r += kProductDepthChunk) {
-    const Eigen::Index d = std::min(kProductDepthChunk, a.rows() - r);
-    out.noalias() += a.middleRows(r, d).transpose() * b.middleRows(r, d);
-  }
+  out.resize(a.cols(), b.cols());
+  ActiveDenseKernels().multiply_transposed_by_chunks(
+      a.data(), static_cast<int>(a.rows()), b.data(), static_cast<int>(b.rows()),
+      static_cast<int>(a.rows()), static_cast<int>(a.cols()), static_cast<int>(b.cols()),
+      out.data(), static_cast<int>(out.rows()));
 }
 
-// out = a^T a, its lower triangle by rank updates of kProductDepthChunk rows, mirrored.
+// out = a^T a by rank updates of fixed chunks, both triangles.
 void MultiplyGramByChunks(const MatX& a, MatX& out) {
-  out.setZero(a.cols(), a.cols());
-  for (Eigen::Index r = 0; r < a.rows(); r += kProductDepthChunk) {
-    const Eigen::Index d = std::min(kProductDepthChunk, a.rows() - r);
-    out.selfadjointView<Eigen::Lower>().rankUpdate(a.middleRows(r, d).transpose());
-  }
-  out.triangularView<Eigen::StrictlyUpper>() = out.transpose();
+  out.resize(a.cols(), a.cols());
+  ActiveDenseKernels().gram_by_chunks(a.data(), static_cast<int>(a.rows()),
+                                      static_cast<int>(a.rows()), static_cast<int>(a.cols()),
+                                      out.data(), static_cast<int>(out.rows()));
 }
 
 }  // namespace

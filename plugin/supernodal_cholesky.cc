@@ -1,10 +1,12 @@
 #include "plugin/supernodal_cholesky.h"
 
-#include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
+
+#include "plugin/dense_kernels.h"
 
 namespace taut {
 
@@ -221,10 +223,11 @@ bool SupernodalCholesky::Factorize(const double* a_val) {
 
 // Panel_t(rows_d[i], rows_d[j]) -= sum_c L_d(i, c) L_d(j, c) for k1 <= j < k2, i >= j.
 void SupernodalCholesky::SubtractUpdate(int d, int k1, int k2, int t) {
-  const ConstPanel l_d = read_panel(d);
+  const double* l_d = values_.data() + val_start_[d];
   const int n1 = k2 - k1, n2 = rows_in(d) - k1;
-  Panel update(update_.data(), n2, n1);
-  update.noalias() = l_d.middleRows(k1, n2) * l_d.middleRows(k1, n1).transpose();
+  ActiveDenseKernels().multiply_by_transposed(l_d + k1, rows_in(d), l_d + k1, rows_in(d), n2, n1,
+                                              width(d), update_.data(), n2);
+  const Panel update(update_.data(), n2, n1);
   const int* rows_d = rows_.data() + row_start_[d];
   Panel l_t = panel(t);
   const int first_t = sn_start_[t];
@@ -234,89 +237,63 @@ void SupernodalCholesky::SubtractUpdate(int d, int k1, int k2, int t) {
   }
 }
 
-// L_tt L_tt^T = diagonal block (Eigen's blocked in-place Cholesky); L_below = below L_tt^-T.
+// L_tt L_tt^T = diagonal block (blocked in-place Cholesky); L_below = below L_tt^-T.
 bool SupernodalCholesky::FactorPanel(int t) {
-  Panel l_t = panel(t);
+  const DenseKernels& kernels = ActiveDenseKernels();
+  double* l_t = values_.data() + val_start_[t];
   const int w = width(t), m = rows_in(t);
-  Eigen::Ref<Eigen::MatrixXd> diagonal = l_t.topRows(w);
-  const Eigen::Index failed = Eigen::internal::llt_inplace<double, Eigen::Lower>::blocked(diagonal);
+  const int failed = kernels.cholesky_lower(l_t, m, w);
   if (failed >= 0) {
-    failed_column_ = sn_start_[t] + static_cast<int>(failed);
+    failed_column_ = sn_start_[t] + failed;
     failed_pivot_negative_ = true;
     return false;
   }
   for (int k = 0; k < w; ++k)
-    if (!std::isfinite(diagonal(k, k))) {
+    if (!std::isfinite(l_t[k * m + k])) {
       failed_column_ = sn_start_[t] + k;
       return false;
     }
-  if (m > w)
-    diagonal.triangularView<Eigen::Lower>().transpose().solveInPlace<Eigen::OnTheRight>(
-        l_t.bottomRows(m - w));
+  if (m > w) kernels.solve_right_lower_transposed(l_t, m, w, l_t + w, m, m - w);
   return true;
 }
 
-namespace {
-// A row-major (rows x width) block of right-hand sides; one column maps as a vector, so the
-// triangular solves below take Eigen's vector kernels (the matrix kernels pack their operands,
-// which for a single column costs more than the solve).
-template <int kCols>
-using SolveRowBlock = Eigen::Map<
-    Eigen::Matrix<double, Eigen::Dynamic, kCols, kCols == 1 ? Eigen::ColMajor : Eigen::RowMajor>>;
-}  // namespace
-
-// Forward L Z = Y, one supernode's dense blocks at a time.
-template <int kCols>
-void SupernodalCholesky::SolveLowerIn(double* y_data, int width_b) const {
-  SolveRowBlock<kCols> y(y_data, n_, width_b);
+// Forward L Z = Y, one supernode's dense blocks at a time (Y row-major, width_b columns).
+void SupernodalCholesky::SolveLower(double* y_data, int width_b) const {
+  TAUT_ASSERT(width_b <= kMaxSolveColumns);
+  const DenseKernels& kernels = ActiveDenseKernels();
+  double* t = solve_work_.data();
   const int num_sn = num_supernodes();
   for (int s = 0; s < num_sn; ++s) {
-    const ConstPanel l_s = read_panel(s);
     const int w = width(s), below = rows_in(s) - w;
-    auto y_s = y.middleRows(sn_start_[s], w);
+    double* y_s = y_data + static_cast<std::ptrdiff_t>(sn_start_[s]) * width_b;
     // Zero rows stay zero (sparse right-hand sides such as columns of J^T).
-    if ((y_s.array() == 0.0).all()) continue;
-    l_s.topRows(w).template triangularView<Eigen::Lower>().solveInPlace(y_s);
-    if (below == 0) continue;
-    SolveRowBlock<kCols> t(solve_work_.data(), below, width_b);
-    t.noalias() = l_s.bottomRows(below) * y_s;
+    if (std::all_of(y_s, y_s + w * width_b, [](double v) { return v == 0.0; })) continue;
+    kernels.forward_supernode(values_.data() + val_start_[s], rows_in(s), w, below, y_s, width_b,
+                              t);
     const int* rows_below = rows_.data() + row_start_[s] + w;
-    for (int k = 0; k < below; ++k) y.row(rows_below[k]) -= t.row(k);
+    for (int k = 0; k < below; ++k) {
+      double* y_row = y_data + static_cast<std::ptrdiff_t>(rows_below[k]) * width_b;
+      for (int c = 0; c < width_b; ++c) y_row[c] -= t[k * width_b + c];
+    }
   }
 }
 
 // Backward L^T X = Z, supernodes in reverse order.
-template <int kCols>
-void SupernodalCholesky::SolveLowerTransposedIn(double* y_data, int width_b) const {
-  SolveRowBlock<kCols> y(y_data, n_, width_b);
-  for (int s = num_supernodes() - 1; s >= 0; --s) {
-    const ConstPanel l_s = read_panel(s);
-    const int w = width(s), below = rows_in(s) - w;
-    auto y_s = y.middleRows(sn_start_[s], w);
-    if (below > 0) {
-      SolveRowBlock<kCols> t(solve_work_.data(), below, width_b);
-      const int* rows_below = rows_.data() + row_start_[s] + w;
-      for (int k = 0; k < below; ++k) t.row(k) = y.row(rows_below[k]);
-      y_s.noalias() -= l_s.bottomRows(below).transpose() * t;
-    }
-    l_s.topRows(w).template triangularView<Eigen::Lower>().transpose().solveInPlace(y_s);
-  }
-}
-
-void SupernodalCholesky::SolveLower(double* y_data, int width_b) const {
-  TAUT_ASSERT(width_b <= kMaxSolveColumns);
-  if (width_b == 1)
-    SolveLowerIn<1>(y_data, width_b);
-  else
-    SolveLowerIn<Eigen::Dynamic>(y_data, width_b);
-}
-
 void SupernodalCholesky::SolveLowerTransposed(double* y_data, int width_b) const {
   TAUT_ASSERT(width_b <= kMaxSolveColumns);
-  if (width_b == 1)
-    SolveLowerTransposedIn<1>(y_data, width_b);
-  else
-    SolveLowerTransposedIn<Eigen::Dynamic>(y_data, width_b);
+  const DenseKernels& kernels = ActiveDenseKernels();
+  double* t = solve_work_.data();
+  for (int s = num_supernodes() - 1; s >= 0; --s) {
+    const int w = width(s), below = rows_in(s) - w;
+    const int* rows_below = rows_.data() + row_start_[s] + w;
+    for (int k = 0; k < below; ++k) {
+      const double* y_row = y_data + static_cast<std::ptrdiff_t>(rows_below[k]) * width_b;
+      std::copy(y_row, y_row + width_b, t + k * width_b);
+    }
+    double* y_s = y_data + static_cast<std::ptrdiff_t>(sn_start_[s]) * width_b;
+    kernels.backward_supernode(values_.data() + val_start_[s], rows_in(s), w, below, y_s, width_b,
+                               t);
+  }
 }
 
 // C^-1 = L^-T L^-1.

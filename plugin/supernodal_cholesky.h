@@ -82,13 +82,9 @@ class SupernodalCholesky {
                        const std::vector<int>& c_source);
   // Step 2 for one descendant d of t: rows [k1, m_d) of d's panel against rows [k1, k2).
   void SubtractUpdate(int d, int k1, int k2, int t);
-  // Step 3: dense Cholesky of t's diagonal block and the triangular solve below it.
+  // Step 3: dense Cholesky of t's diagonal block and the triangular solve below it (steps 2-3
+  // and the solves run on the CPU's dense kernel set, plugin/dense_kernels.h).
   bool FactorPanel(int t);
-  // The solves' halves for kCols right-hand sides (1: vector kernels; Eigen::Dynamic: blocks).
-  template <int kCols>
-  void SolveLowerIn(double* y_data, int width_b) const;
-  template <int kCols>
-  void SolveLowerTransposedIn(double* y_data, int width_b) const;
 
   Panel panel(int s) { return Panel(values_.data() + val_start_[s], rows_in(s), width(s)); }
   ConstPanel read_panel(int s) const {

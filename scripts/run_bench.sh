@@ -62,6 +62,8 @@ import json, os, sys
 run = json.load(open(sys.argv[1]))
 ctx = run["context"]
 ctx["cpu_model"] = sys.argv[4] or "unknown"
+if ctx.get("dense_kernels"):  # bench/context_bench.cc: the kernel set of plugin/dense_kernels.h
+    ctx["cpu_model"] += f" (dense kernels: {ctx['dense_kernels']})"
 for b in run["benchmarks"]:
     b["run_date"] = ctx.get("date")
     b["run_cpu_model"] = ctx["cpu_model"]

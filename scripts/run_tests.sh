@@ -62,6 +62,9 @@ run_ctest() {
 stage_release() {
   taut_build_release
   run_ctest build/release
+  # The generic dense kernels too (on an AVX2 machine the run above used the AVX2 + FMA set):
+  # the factorization's tests and the other set's determinism pins (plugin/dense_kernels.h).
+  TAUT_DENSE_KERNELS=generic run_ctest build/release -R 'Determinism|DenseKernels|Supernodal|SparseLdlt'
 }
 
 # Stage 1b: the default build links no GPL code (CHOLMOD is opt-in).

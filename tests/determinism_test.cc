@@ -2,6 +2,9 @@
 // are pinned (tests/data/determinism_hashes.txt) so an unintended change of results shows up.
 // Scenes with bodies large enough for the CHOLMOD backend are marked "-" there: their last bits
 // depend on the BLAS kernels OpenBLAS picks for the CPU, so only run-to-run equality is checked.
+// The dense kernels (plugin/dense_kernels.h) round differently in their generic and AVX2 + FMA
+// builds, so each scene has one pin per kernel set; the test checks the set this process runs
+// (TAUT_DENSE_KERNELS=generic checks the other on an AVX2 machine).
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -10,6 +13,7 @@
 #include <sstream>
 
 #include "demos/scenes/scene.h"
+#include "plugin/dense_kernels.h"
 
 namespace taut {
 namespace {
@@ -25,7 +29,7 @@ uint64_t RunScene(const SceneInfo& info) {
   return scene->CalcStateHash();
 }
 
-// Pinned hashes by scene name.
+// Pinned hashes by "<scene> <kernel set>".
 std::map<std::string, std::string> ReadPinnedHashes() {
   std::map<std::string, std::string> pinned;
   std::ifstream in(std::string(TAUT_TEST_DATA_DIR) + "/determinism_hashes.txt");
@@ -33,15 +37,16 @@ std::map<std::string, std::string> ReadPinnedHashes() {
   while (std::getline(in, line)) {
     if (line.empty() || line[0] == '#') continue;
     std::istringstream fields(line);
-    std::string name, hash;
-    fields >> name >> hash;
-    pinned[name] = hash;
+    std::string name, kernels, hash;
+    fields >> name >> kernels >> hash;
+    pinned[name + " " + kernels] = hash;
   }
   return pinned;
 }
 
 TEST(DeterminismTest, EverySceneRunTwiceGivesTheSameStateHashAndMatchesItsPin) {
   const std::map<std::string, std::string> pinned = ReadPinnedHashes();
+  const std::string kernels = ActiveDenseKernels().name;
   for (const SceneInfo& info : SceneRegistry()) {
     uint64_t first = 0, second = 0;
     try {
@@ -54,18 +59,19 @@ TEST(DeterminismTest, EverySceneRunTwiceGivesTheSameStateHashAndMatchesItsPin) {
     }
     char hex[32];
     std::snprintf(hex, sizeof(hex), "%016llx", static_cast<unsigned long long>(first));
-    std::printf("%s %s\n", info.name.c_str(), hex);
+    std::printf("%s %s %s\n", info.name.c_str(), kernels.c_str(), hex);
     EXPECT_EQ(first, second) << info.name << ": two runs differ";
 #if TAUT_PINNED_HASHES
     // Pins hold for the Release build on Debian 12 (GCC 12, Eigen 3.4, Bullet 3.24 float64);
     // sanitizer builds compile with other optimizations and only check run-to-run equality.
-    const auto it = pinned.find(info.name);
+    const std::string key = info.name + " " + kernels;
+    const auto it = pinned.find(key);
     if (it != pinned.end() && it->second == "-") continue;  // BLAS-dependent: equality only
     if (it == pinned.end()) {
-      ADD_FAILURE() << info.name << ": no pinned hash; add '" << info.name << " " << hex
+      ADD_FAILURE() << key << ": no pinned hash; add '" << key << " " << hex
                     << "' to tests/data/determinism_hashes.txt";
     } else {
-      EXPECT_EQ(it->second, hex) << info.name << ": results changed (pinned " << it->second
+      EXPECT_EQ(it->second, hex) << key << ": results changed (pinned " << it->second
                                  << "); if intended, update tests/data/determinism_hashes.txt";
     }
 #endif

@@ -1,0 +1,57 @@
+#include "plugin/dense_kernels.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <algorithm>
+#include <cstdlib>
+
+#include "plugin/blas_core_check.h"
+#include "plugin/common.h"
+
+namespace taut {
+namespace dense_generic {
+#include "plugin/dense_kernels_body.inc"
+
+const DenseKernels kTable = {"generic",
+                             MultiplyByTransposed,
+                             CholeskyLower,
+                             SolveRightLowerTransposed,
+                             ForwardSupernode,
+                             BackwardSupernode,
+                             MultiplyTransposedByChunks,
+                             GramByChunks};
+}  // namespace dense_generic
+
+// Defined in dense_kernels_avx2.cc: the AVX2 table, or nullptr in a build without it.
+const DenseKernels* GetAvx2DenseKernelTable();
+
+const DenseKernels& GenericDenseKernels() { return dense_generic::kTable; }
+
+const DenseKernels* Avx2DenseKernels() {
+  static const DenseKernels* const avx2 =
+      DetectCpuVectorSupport().avx2 ? GetAvx2DenseKernelTable() : nullptr;
+  return avx2;
+}
+
+std::string ChooseDenseKernels(const std::string& requested, bool avx2_available) {
+  if (requested.empty()) return avx2_available ? "avx2" : "generic";
+  TAUT_DEMAND(requested == "generic" || requested == "avx2",
+              "TAUT_DENSE_KERNELS: unknown dense kernel set '", requested,
+              "' (expected 'generic' or 'avx2')");
+  TAUT_DEMAND(requested == "generic" || avx2_available,
+              "TAUT_DENSE_KERNELS=avx2: this CPU or build has no AVX2 + FMA kernels "
+              "(use 'generic' or leave it unset)");
+  return requested;
+}
+
+const DenseKernels& ActiveDenseKernels() {
+  static const DenseKernels* const active = [] {
+    const char* env = std::getenv("TAUT_DENSE_KERNELS");
+    const bool avx2_available = Avx2DenseKernels() != nullptr;
+    return ChooseDenseKernels(env ? env : "", avx2_available) == "avx2" ? Avx2DenseKernels()
+                                                                        : &GenericDenseKernels();
+  }();
+  return *active;
+}
+
+}  // namespace taut
