@@ -1,8 +1,8 @@
 // The dense kernels of the sparse factorization and of the dual path's Delassus blocks, compiled
 // twice and chosen once per process by the CPU: a generic x86-64 (SSE2) build, and on x86-64 an
 // AVX2 + FMA build of the same source (plugin/dense_kernels_body.inc). Debian packages are built
-// for the generic ISA; these kernels are where the wider vectors pay (supernodal factor of the
-// 368-hex armadillo 3.3 -> 1.8 ms, 25k-tet beam 172 -> 79 ms, AMD EPYC; docs/solver.md).
+// for the generic ISA; these kernels are where the wider vectors pay (factor + solve of the
+// 368-hex armadillo 2.3 -> 1.4 ms, of a 100k-tet beam 2.4 -> 1.2 s, AMD EPYC; README).
 //
 // All matrices are column-major with a leading dimension (ld >= rows); blocks of right-hand sides
 // of the supernodal solves are row-major with `cols` entries per row. The two builds round
