@@ -10,16 +10,9 @@
 
 namespace taut {
 namespace dense_generic {
+#define TAUT_DENSE_KERNEL_SET_NAME "generic"
 #include "plugin/dense_kernels_body.inc"
-
-const DenseKernels kTable = {"generic",
-                             MultiplyByTransposed,
-                             CholeskyLower,
-                             SolveRightLowerTransposed,
-                             ForwardSupernode,
-                             BackwardSupernode,
-                             MultiplyTransposedByChunks,
-                             GramByChunks};
+#undef TAUT_DENSE_KERNEL_SET_NAME
 }  // namespace dense_generic
 
 // Defined in dense_kernels_avx2.cc: the AVX2 table, or nullptr in a build without it.

@@ -13,16 +13,9 @@
 
 namespace taut {
 namespace dense_avx2 {
+#define TAUT_DENSE_KERNEL_SET_NAME "avx2"
 #include "plugin/dense_kernels_body.inc"
-
-const DenseKernels kTable = {"avx2",
-                             MultiplyByTransposed,
-                             CholeskyLower,
-                             SolveRightLowerTransposed,
-                             ForwardSupernode,
-                             BackwardSupernode,
-                             MultiplyTransposedByChunks,
-                             GramByChunks};
+#undef TAUT_DENSE_KERNEL_SET_NAME
 }  // namespace dense_avx2
 
 const DenseKernels* GetAvx2DenseKernelTable() { return &dense_avx2::kTable; }
