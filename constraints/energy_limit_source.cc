@@ -28,14 +28,14 @@ double EnergyLimitSource::CalcElementEnergy(const VecX& x, int e) const {
   return body_.model().CalcElementEnergy(e, x);
 }
 
-void EnergyLimitSource::FillRow(const VecX& x, int e, ConstraintRow& row) const {
+void EnergyLimitSource::FillRow(const VecX& x, int e, const Mat3& R, ConstraintRow& row) const {
   // R recomputed from x, then frozen for the Jacobian J = f_e / U_max (docs/math.md §4.5) and
   // the curvature -d^2C/dx^2 = K_e(R) / U_max (AddIslandCurvature): along J,
   // J^T K_e J / U_max = f^T K_e f / U_max^3.
   const ElementModel& model = body_.model();
   ElementVectors forces;
   double f_K_f = 0.0;
-  const double energy = model.CalcElementForcesAndStiffnessAlong(e, x, forces, &f_K_f);
+  const double energy = model.CalcElementForcesAndStiffnessAlongIn(e, x, R, forces, &f_K_f);
   row.C = CalcEnergyLimitValue(energy, u_max_[e]);
   row.curvature_along_j = f_K_f / (u_max_[e] * u_max_[e] * u_max_[e]);
   row.num_nodes = model.nodes_per_element();
@@ -47,16 +47,21 @@ void EnergyLimitSource::FillRow(const VecX& x, int e, ConstraintRow& row) const 
 int EnergyLimitSource::AppendRows(const VecX& x, int body_index, std::vector<ConstraintRow>& rows) {
   const int before = static_cast<int>(rows.size());
   const double tau = settings_.activation_margin;
-  for (int e = 0; e < body_.model().num_elements(); ++e) {
+  const ElementModel& model = body_.model();
+  rows_x_ = x;
+  rows_R_.resize(model.num_elements());
+  for (int e = 0; e < model.num_elements(); ++e) {
     if (std::isinf(u_max_[e])) continue;  // unlimited element: C = 1
     // Cheap energy test first; forces only for rows that are emitted.
-    if (!(CalcEnergyLimitValue(CalcElementEnergy(x, e), u_max_[e]) < tau)) continue;
+    rows_R_[e] = model.CalcElementRotation(e, x);
+    const double energy = model.CalcElementEnergyIn(e, x, rows_R_[e]);
+    if (!(CalcEnergyLimitValue(energy, u_max_[e]) < tau)) continue;
     ConstraintRow& row = rows.emplace_back();
     row.key = key_.Pack(e);  // one bound per element
     row.body = body_index;
     row.element = e;
     row.type = RowType::kEnergyLimit;
-    FillRow(x, e, row);
+    FillRow(x, e, rows_R_[e], row);
   }
   return static_cast<int>(rows.size()) - before;
 }
@@ -64,13 +69,18 @@ int EnergyLimitSource::AppendRows(const VecX& x, int body_index, std::vector<Con
 void EnergyLimitSource::AddIslandCurvature(const IslandIterate& iterate, const ConstraintRow* rows,
                                            const double* weights, int count,
                                            CurvatureSink& sink) const {
+  int rows_frame = -1;  // 1 when the iterate is at rows_x_ (tested once)
   for (int c = 0; c < count; ++c) {
     const ConstraintRow& row = rows[c];
     if (!key_.Owns(row.key) || !(weights[c] > 0.0)) continue;
     const int e = static_cast<int>(key_.Unpack(row.key)[0]);
-    // -d^2 C/dx^2 = K_e(R)/U_max with R frozen at the iterate.
+    // -d^2 C/dx^2 = K_e(R)/U_max with R frozen at the iterate (the rows' R_e when they were
+    // collected at the same positions).
+    const VecX& x = iterate.x(row.body);  // this body's: the same for every row of the source
+    if (rows_frame < 0) rows_frame = x.size() == rows_x_.size() && x == rows_x_;
     ElementMatrix H;
-    body_.model().CalcElementStiffness(e, iterate.x(row.body), H);
+    body_.model().CalcElementStiffnessIn(
+        e, rows_frame ? rows_R_[e] : body_.model().CalcElementRotation(e, x), H);
     H *= weights[c] / u_max_[e];
     sink.AddElementBlock(row.body, e, body_.model().element_nodes(e), H);
   }

@@ -41,13 +41,17 @@ class EnergyLimitSource final : public BodyConstraintSource {
   double CalcElementRatio(const VecX& x, int e) const;
   // U_e of element e at x (rotation recomputed from x) [J].
   double CalcElementEnergy(const VecX& x, int e) const;
-  // Fills C, the element's nodes and J of the row of element e at x.
-  void FillRow(const VecX& x, int e, ConstraintRow& row) const;
+  // Fills C, the element's nodes and J of the row of element e at x, R_e its rotation there.
+  void FillRow(const VecX& x, int e, const Mat3& R, ConstraintRow& row) const;
 
   const DeformableBody& body_;
   EnergyLimitSettings settings_;
   std::vector<double> u_max_;  // U_max,e [J], +inf = unlimited
   RowKeyPacker<1> key_;        // kEnergyLimitRowKey with this source's id
+  // R_e of the last AppendRows, at positions rows_x_: the curvature at the same x reuses them
+  // (one polar decomposition per element and collection, not three per row).
+  VecX rows_x_;
+  std::vector<Mat3> rows_R_;
 };
 
 // The name of earlier releases, kept so that code written against them still compiles.

@@ -202,15 +202,38 @@ Mat9 ClampNegativeModes(const Mat9& H, double kept_fraction) {
 }
 
 Mat12 MapPrincipalHessianToTet(const Mat9& H, const SignedSvd& svd, const TetRestRows& r) {
-  // dP/dx_{n,k} = (U^T e_k)(V^T r_n)^T: entry (x, y) is U_kx (V^T r_n)_y.
-  Eigen::Matrix<double, 9, 12> W;
-  for (int n = 0; n < 4; ++n) {
-    const Vec3 r_hat = svd.V.transpose() * r[n];
-    for (int k = 0; k < 3; ++k)
+  // dP_xy/dx_{n,k} = U_kx (V^T r_n)_y, so W^T H W factors through the two 3x3 frames:
+  // G[(k,y),(l,y')] = sum_{x,x'} U_kx H[(x,y),(x',y')] U_lx' (U on the left index), then
+  // block (k,l) of the result over nodes (n,m) is R_hat G_kl R_hat^T with R_hat's rows
+  // (V^T r_n)^T. About half the flops of the dense 9x12 product, and no general product kernel.
+  Eigen::Matrix<double, 4, 3> r_hat;
+  for (int n = 0; n < 4; ++n) r_hat.row(n) = (svd.V.transpose() * r[n]).transpose();
+  Mat3 G[3][3];  // G[k][l](y, y')
+  for (int y = 0; y < 3; ++y) {
+    for (int y2 = y; y2 < 3; ++y2) {
+      Mat3 B;  // B(x, x') = H[(x,y),(x',y')]
       for (int x = 0; x < 3; ++x)
-        for (int y = 0; y < 3; ++y) W(P(x, y), 3 * n + k) = svd.U(k, x) * r_hat[y];
+        for (int x2 = 0; x2 < 3; ++x2) B(x, x2) = H(P(x, y), P(x2, y2));
+      const Mat3 UBUt = svd.U * B * svd.U.transpose();
+      for (int k = 0; k < 3; ++k)
+        for (int l = 0; l < 3; ++l) {
+          G[k][l](y, y2) = UBUt(k, l);
+          G[l][k](y2, y) = UBUt(k, l);  // H symmetric: G[(l,y'),(k,y)] = G[(k,y),(l,y')]
+        }
+    }
   }
-  return W.transpose() * H * W;
+  Mat12 out;
+  for (int k = 0; k < 3; ++k) {
+    for (int l = k; l < 3; ++l) {
+      const Eigen::Matrix4d block = r_hat * G[k][l] * r_hat.transpose();
+      for (int n = 0; n < 4; ++n)
+        for (int m = 0; m < 4; ++m) {
+          out(3 * n + k, 3 * m + l) = block(n, m);
+          out(3 * m + l, 3 * n + k) = block(n, m);
+        }
+    }
+  }
+  return out;
 }
 
 }  // namespace taut

@@ -87,6 +87,17 @@ class ElementModel {
   // Deformation gradient dx/dX at the element centre (constant over a tet) [-].
   virtual Mat3 CalcElementDeformationGradient(int e, const VecX& x) const = 0;
 
+  // --- The same with R_e given: for callers that evaluate one element several times at the same
+  // x (energy-limit rows: energy, then forces, then stiffness), R_e from CalcElementRotation at
+  // that x, so its polar decomposition runs once. Results are bit for bit the calls above. ---
+  // R_e at x (the element's corotated frame).
+  virtual Mat3 CalcElementRotation(int e, const VecX& x) const = 0;
+  virtual double CalcElementEnergyIn(int e, const VecX& x, const Mat3& R) const = 0;
+  virtual double CalcElementForcesAndStiffnessAlongIn(int e, const VecX& x, const Mat3& R,
+                                                      ElementVectors& forces,
+                                                      double* f_K_f) const = 0;
+  virtual void CalcElementStiffnessIn(int e, const Mat3& R, ElementMatrix& K) const = 0;
+
   // --- Contact ---
   // The body's boundary as contact points (its boundary nodes) and outward triangles.
   virtual ContactSurface MakeContactSurface() const = 0;

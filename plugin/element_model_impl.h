@@ -56,6 +56,11 @@ class ElementModelImpl : public ElementModel {
                                             double* f_K_f) const final;
   void CalcElementStiffness(int e, const VecX& x, ElementMatrix& K) const final;
   Mat3 CalcElementDeformationGradient(int e, const VecX& x) const final;
+  Mat3 CalcElementRotation(int e, const VecX& x) const final;
+  double CalcElementEnergyIn(int e, const VecX& x, const Mat3& R) const final;
+  double CalcElementForcesAndStiffnessAlongIn(int e, const VecX& x, const Mat3& R,
+                                              ElementVectors& forces, double* f_K_f) const final;
+  void CalcElementStiffnessIn(int e, const Mat3& R, ElementMatrix& K) const final;
 
   ContactSurface MakeContactSurface() const final { return Traits::MakeContactSurface(*mesh_); }
   ContactSurface MakeEmbeddedContactSurface(const SurfaceMesh& surface) const final {
@@ -265,8 +270,7 @@ double ElementModelImpl<Traits>::CalcEnergy(const VecX& x) const {
 
 template <typename Traits>
 double ElementModelImpl<Traits>::CalcElementEnergy(int e, const VecX& x) const {
-  const Nodes xe = GatherElement(x, e);
-  return Traits::CalcEnergy(data_, e, xe, Traits::CalcFrame(data_, e, xe));
+  return CalcElementEnergyIn(e, x, CalcElementRotation(e, x));
 }
 
 template <typename Traits>
@@ -279,14 +283,38 @@ template <typename Traits>
 double ElementModelImpl<Traits>::CalcElementForcesAndStiffnessAlong(int e, const VecX& x,
                                                                     ElementVectors& forces,
                                                                     double* f_K_f) const {
+  return CalcElementForcesAndStiffnessAlongIn(e, x, CalcElementRotation(e, x), forces, f_K_f);
+}
+
+template <typename Traits>
+void ElementModelImpl<Traits>::CalcElementStiffness(int e, const VecX& x, ElementMatrix& K) const {
+  CalcElementStiffnessIn(e, CalcElementRotation(e, x), K);
+}
+
+template <typename Traits>
+Mat3 ElementModelImpl<Traits>::CalcElementRotation(int e, const VecX& x) const {
+  return Traits::CalcFrame(data_, e, GatherElement(x, e)).R;
+}
+
+template <typename Traits>
+double ElementModelImpl<Traits>::CalcElementEnergyIn(int e, const VecX& x, const Mat3& R) const {
   const Nodes xe = GatherElement(x, e);
-  const typename Traits::Frame frame = Traits::CalcFrame(data_, e, xe);
+  return Traits::CalcEnergy(data_, e, xe, Traits::MakeFrame(data_, e, xe, R));
+}
+
+template <typename Traits>
+double ElementModelImpl<Traits>::CalcElementForcesAndStiffnessAlongIn(int e, const VecX& x,
+                                                                      const Mat3& R,
+                                                                      ElementVectors& forces,
+                                                                      double* f_K_f) const {
+  const Nodes xe = GatherElement(x, e);
+  const typename Traits::Frame frame = Traits::MakeFrame(data_, e, xe, R);
   const Nodes fe = Traits::CalcForces(data_, e, xe, frame);
   for (int a = 0; a < kNodes; ++a) forces[a] = fe[a];
   if (f_K_f != nullptr) {
     // f^T R K0 R^T f = w^T K0 w with w_a = R^T f_a (K0 stored at rest).
     Nodes w;
-    for (int a = 0; a < kNodes; ++a) w[a] = frame.R.transpose() * fe[a];
+    for (int a = 0; a < kNodes; ++a) w[a] = R.transpose() * fe[a];
     const Nodes K0w = Traits::MultiplyRestStiffness(data_, e, w);
     double sum = 0.0;
     for (int a = 0; a < kNodes; ++a) sum += w[a].dot(K0w[a]);
@@ -296,9 +324,9 @@ double ElementModelImpl<Traits>::CalcElementForcesAndStiffnessAlong(int e, const
 }
 
 template <typename Traits>
-void ElementModelImpl<Traits>::CalcElementStiffness(int e, const VecX& x, ElementMatrix& K) const {
-  const Nodes xe = GatherElement(x, e);
-  K = Traits::CalcFrozenStiffness(data_, e, Traits::CalcFrame(data_, e, xe).R);
+void ElementModelImpl<Traits>::CalcElementStiffnessIn(int e, const Mat3& R,
+                                                      ElementMatrix& K) const {
+  K = Traits::CalcFrozenStiffness(data_, e, R);
 }
 
 template <typename Traits>

@@ -40,6 +40,10 @@ struct HexElementTraits {
   static Frame CalcFrame(const RestData& data, int e, const Nodes& x) {
     return {CalcHexRotation(data.elements[e], x, data.rotation_method)};
   }
+  // The frame at x with R computed before (CalcFrame's R at the same x).
+  static Frame MakeFrame(const RestData& /*data*/, int /*e*/, const Nodes& /*x*/, const Mat3& R) {
+    return {R};
+  }
   // U = 1/2 (R^T x - X)^T K_e (R^T x - X).
   static double CalcEnergy(const RestData& data, int e, const Nodes& x, const Frame& frame) {
     return CalcCorotatedHexEnergy(data.elements[e], x, frame.R);

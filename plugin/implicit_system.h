@@ -187,7 +187,6 @@ class ImplicitSystem {
   CholmodCholesky newton_cholmod_;
   mutable VecX rhs_free_;
   mutable MatX columns_free_;
-  mutable VecX product_free_;
 };
 
 }  // namespace taut

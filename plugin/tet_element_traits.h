@@ -47,6 +47,10 @@ struct TetElementTraits {
     const Mat3 G = CalcTetDeformationGradient(data.rest.elements[e], x);
     return {G, CalcPolarRotation(G)};
   }
+  // The frame at x with R computed before (CalcFrame's R at the same x).
+  static Frame MakeFrame(const RestData& data, int e, const Nodes& x, const Mat3& R) {
+    return {CalcTetDeformationGradient(data.rest.elements[e], x), R};
+  }
   // Psi = V [mu ||S - I||^2 + lambda/2 tr(S - I)^2], S = R^T G.
   static double CalcEnergy(const RestData& data, int e, const Nodes& /*x*/, const Frame& frame) {
     return CalcCorotatedTetEnergy(data.rest.elements[e], data.lame, frame.G, frame.R);

@@ -4,6 +4,7 @@
 //   lumped mass = density x rest volume, element rest volumes summing to the body's volume.
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <memory>
 #include <random>
@@ -316,6 +317,35 @@ TYPED_TEST(ElementModelConformanceTest, LumpedMassIsDensityTimesTheRestVolume) {
     for (int a = 0; a < model.nodes_per_element(); ++a)
       share[model.element_nodes(e)[a]] += model.element_rest_volume(e) / model.nodes_per_element();
   EXPECT_LT((mass - kMaterial.density * share).norm(), 1e-12 * mass.norm());
+}
+
+// The calls with R_e given (CalcElementRotation, then the ...In calls at the same x) are the
+// plain calls bit for bit; and R_e is a rotation whose frame makes the energy rotation invariant.
+TYPED_TEST(ElementModelConformanceTest, CallsWithTheRotationGivenAreThePlainCalls) {
+  ElementModel& model = *this->model_;
+  const VecX x = this->Deform(0.15, TypeParam::kNonAffine);
+  ElementVectors plain_f, given_f;
+  ElementMatrix plain_K, given_K;
+  for (int e = 0; e < model.num_elements(); ++e) {
+    const Mat3 R = model.CalcElementRotation(e, x);
+    EXPECT_LT((R.transpose() * R - Mat3::Identity()).norm(), 1e-12);
+    EXPECT_NEAR(R.determinant(), 1.0, 1e-12);
+    EXPECT_EQ(model.CalcElementEnergyIn(e, x, R), model.CalcElementEnergy(e, x));
+    double plain_fKf = 0.0, given_fKf = 0.0;
+    const double plain_U = model.CalcElementForcesAndStiffnessAlong(e, x, plain_f, &plain_fKf);
+    const double given_U = model.CalcElementForcesAndStiffnessAlongIn(e, x, R, given_f, &given_fKf);
+    EXPECT_EQ(plain_U, given_U);
+    EXPECT_EQ(plain_fKf, given_fKf);
+    for (int a = 0; a < model.nodes_per_element(); ++a) EXPECT_TRUE(plain_f[a] == given_f[a]);
+    model.CalcElementStiffness(e, x, plain_K);
+    model.CalcElementStiffnessIn(e, R, given_K);
+    EXPECT_TRUE(plain_K == given_K);
+  }
+  // A different R gives a different energy (the given rotation is used, not recomputed).
+  const Mat3 R0 = model.CalcElementRotation(0, x);
+  const Mat3 turned = Eigen::AngleAxisd(0.3, Vec3::UnitZ()).toRotationMatrix() * R0;
+  EXPECT_GT(std::abs(model.CalcElementEnergyIn(0, x, turned) - model.CalcElementEnergy(0, x)),
+            1e-6 * model.CalcElementEnergy(0, x));
 }
 
 }  // namespace

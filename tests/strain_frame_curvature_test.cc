@@ -261,5 +261,34 @@ TEST(StrainFrameCurvatureClampTest, KeepsModesAboveTheKeptFraction) {
   EXPECT_LT((clamped - Q * psd.asDiagonal() * Q.transpose()).norm(), 1e-12);
 }
 
+// The factored map (two 3x3 frames) against the product W^T H W with W = dvec(P)/dx written out:
+// W((x, y), (n, k)) = U_kx (V^T r_n)_y, P indexed 3 x + y.
+TEST(StrainFrameCurvatureMapTest, EqualsTheDenseChainRuleProduct) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> n;
+  std::array<Vec3, 4> X;
+  const TetRestRows r = MakeFrameTestRest(&X);
+  for (int trial = 0; trial < 50; ++trial) {
+    Mat9 A;
+    for (int k = 0; k < 81; ++k) A.data()[k] = n(rng);
+    const Mat9 H = A + A.transpose();
+    SignedSvd svd;
+    svd.U = RandomRotation(rng);
+    svd.V = RandomRotation(rng);
+    svd.s = RandomFrameTestValues(&rng);
+    Eigen::Matrix<double, 9, 12> W;
+    for (int node = 0; node < 4; ++node) {
+      const Vec3 r_hat = svd.V.transpose() * r[node];
+      for (int k = 0; k < 3; ++k)
+        for (int x = 0; x < 3; ++x)
+          for (int y = 0; y < 3; ++y) W(3 * x + y, 3 * node + k) = svd.U(k, x) * r_hat[y];
+    }
+    const Mat12 expected = W.transpose() * H * W;
+    const Mat12 mapped = MapPrincipalHessianToTet(H, svd, r);
+    EXPECT_LT((mapped - expected).cwiseAbs().maxCoeff(), 1e-12 * expected.norm());
+    EXPECT_LT((mapped - mapped.transpose()).cwiseAbs().maxCoeff(), 1e-12 * expected.norm());
+  }
+}
+
 }  // namespace
 }  // namespace taut
