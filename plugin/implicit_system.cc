@@ -67,6 +67,7 @@ void ImplicitSystem::Build(const ElementModel& model, const std::vector<NodeKind
   if (n > 0 && use_cholmod_) cholmod_.Analyze(A_);
   if (n > 0 && !use_cholmod_) ldlt_.Analyze(A_);
   rhs_free_.resize(n);
+  product_free_.resize(n);
   for (VecX* v : {&cg_r_, &cg_z_, &cg_p_, &cg_ap_, &cg_x_}) v->resize(n);
   newton_analyzed_ = false;
   factor_current_ = false;
@@ -103,17 +104,9 @@ void ImplicitSystem::MultiplyWith(const Eigen::SparseMatrix<double>& M, const Ve
                                   VecX& out) const {
   const int n = num_free_dofs();
   for (int i = 0; i < n; ++i) rhs_free_[i] = v[free_to_dof_[i]];
+  product_free_.noalias() = M * rhs_free_;
   out.setZero(v.size());
-  // M is symmetric (A and the Newton matrix both are), so (M v)_j = M_{:,j} . v: one gathered dot
-  // product per stored column, without the scattered writes of the column-major M v.
-  const int* outer = M.outerIndexPtr();
-  const int* inner = M.innerIndexPtr();
-  const double* values = M.valuePtr();
-  for (int j = 0; j < n; ++j) {
-    double sum = 0.0;
-    for (int k = outer[j]; k < outer[j + 1]; ++k) sum += values[k] * rhs_free_[inner[k]];
-    out[free_to_dof_[j]] = sum;
-  }
+  for (int i = 0; i < n; ++i) out[free_to_dof_[i]] = product_free_[i];
 }
 
 void ImplicitSystem::Factor(const std::string& body) {

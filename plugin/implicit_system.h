@@ -187,6 +187,7 @@ class ImplicitSystem {
   CholmodCholesky newton_cholmod_;
   mutable VecX rhs_free_;
   mutable MatX columns_free_;
+  mutable VecX product_free_;
 };
 
 }  // namespace taut
