@@ -29,9 +29,9 @@ double EnergyLimitSource::CalcElementEnergy(const VecX& x, int e) const {
 }
 
 void EnergyLimitSource::FillRow(const VecX& x, int e, const Mat3& R, ConstraintRow& row) const {
-  // R recomputed from x, then frozen for the Jacobian J = f_e / U_max (docs/math.md §4.5) and
-  // the curvature -d^2C/dx^2 = K_e(R) / U_max (AddIslandCurvature): along J,
-  // J^T K_e J / U_max = f^T K_e f / U_max^3.
+  // R = R_e at x (computed once by AppendRows), frozen for the Jacobian J = f_e / U_max
+  // (docs/math.md §4.5) and the curvature -d^2C/dx^2 = K_e(R) / U_max (AddIslandCurvature):
+  // along J, J^T K_e J / U_max = f^T K_e f / U_max^3.
   const ElementModel& model = body_.model();
   ElementVectors forces;
   double f_K_f = 0.0;
