@@ -41,9 +41,17 @@ if ! command -v python3 >/dev/null; then
   echo "error: python3 is needed for the summary (apt-get install python3)" >&2
   exit 1
 fi
-taut_stage "Configuring ${build_dir} (Release, benchmarks only)"
-cmake -G Ninja -S . -B "${build_dir}" -DCMAKE_BUILD_TYPE=Release -DTAUT_BUILD_BENCH=ON \
-  -DTAUT_BUILD_TESTS=OFF -DTAUT_BUILD_DEMOS=OFF >/dev/null
+# A new build dir is configured for the benchmarks only; an existing one (TAUT_BENCH_BUILD_DIR
+# pointing at a development build) keeps its tests and demos, which would otherwise stop being
+# rebuilt there and go stale.
+if [[ -f "${build_dir}/CMakeCache.txt" ]]; then
+  taut_stage "Configuring ${build_dir} (Release, its other targets kept)"
+  cmake -G Ninja -S . -B "${build_dir}" -DCMAKE_BUILD_TYPE=Release -DTAUT_BUILD_BENCH=ON >/dev/null
+else
+  taut_stage "Configuring ${build_dir} (Release, benchmarks only)"
+  cmake -G Ninja -S . -B "${build_dir}" -DCMAKE_BUILD_TYPE=Release -DTAUT_BUILD_BENCH=ON \
+    -DTAUT_BUILD_TESTS=OFF -DTAUT_BUILD_DEMOS=OFF >/dev/null
+fi
 taut_stage "Building taut_bench (-j${TAUT_JOBS})"
 cmake --build "${build_dir}" -j"${TAUT_JOBS}" --target taut_bench
 taut_fix_openblas_coretype "${build_dir}/bench/taut_bench"
