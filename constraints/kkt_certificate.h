@@ -42,8 +42,8 @@ KktResiduals CalcKktResiduals(const std::vector<IslandBody*>& bodies, const Isla
 // the certificate (complementarity or stationarity), those of (v, lambda_fit) if they pass, with
 // lambda_fit the limit rows' least-squares multipliers at v (constraints/limit_multiplier_refit.h):
 // the certificate asks only that SOME multipliers satisfy the KKT conditions with v. `certified`
-// <- the multipliers whose residuals are returned (the forces a solver reports); the solvers keep
-// their own lambda for warm starts (docs/math.md §5.10, refitted multipliers).
+// <- the multipliers whose residuals are returned (the forces a solver reports, and the primal
+// path's next warm start on rows at their bounds; docs/math.md §5.10, refitted multipliers).
 KktResiduals CalcKktResidualsWithRefit(const std::vector<IslandBody*>& bodies,
                                        const IslandRows& rows, const VecX& lambda,
                                        const std::vector<VecX>& v, double h, double distance_scale,

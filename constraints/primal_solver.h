@@ -111,6 +111,9 @@ class PrimalSolver {
   // early stop, PrimalSettings::stop_newton_on_certificate); leaves lambda_ = Proj(y(v)).
   bool IsNewtonIterateCertified(const std::vector<IslandBody*>& bodies, double h,
                                 const SqpSettings& settings);
+  // Stage, at a certified iterate: the warm start of the next step (iterate_) from the
+  // multipliers that certified this one, slack limit rows from lambda_bar.
+  void StoreCertifiedWarmStart(double violation_tolerance);
   // lambda_c = Proj_c(y_c(v)) and D_c at v (row velocities jv_ = J v).
   void CalcProjectedMultipliers();
   // grad = A(v - v*) - J^T lambda on free blocks.
@@ -141,9 +144,10 @@ class PrimalSolver {
   void AddRowHessianTimes(const std::vector<VecX>& u, std::vector<VecX>& out) const;
 
   IslandRows rows_;
-  KeyedMultipliers iterate_;   // lambda_bar of this step by key
+  KeyedMultipliers iterate_;   // lambda_bar of this step by key (certified: the next warm start)
   VecX lambda_bar_, lambda_;   // estimates, and Proj(y(v)) at the Newton iterate
   VecX reported_;              // the multipliers of the last certificate (multipliers())
+  VecX work_lambda_;           // the warm start being stored (StoreCertifiedWarmStart)
   VecX newton_reported_;       // ... of the Newton loop's certificate
   VecX rho_, g0_, jv_, s_;     // penalties, g_c(v) = g0 + J v, J v, J d
   KeyedMultipliers kept_rho_;  // limit rows' rho of this multiplier iteration by key
