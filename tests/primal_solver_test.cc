@@ -450,9 +450,9 @@ struct BoxOnBlock {
   double z_1s = 0.0, z_2s = 0.0;
   int unconverged = 0, coupled = 0;
 };
-BoxOnBlock RestBoxOnBlock(IslandSolverKind solver) {
-  BulletWorldHolder holder;
-  holder.world.mutable_solver_settings().solver = solver;
+// Adds the soft block (fixed at its base, isotropic limits s_min..s_max) and the 2 kg box 0.5 mm
+// above it to `holder`; returns the box.
+btRigidBody* AddBoxOnLimitedBlock(BulletWorldHolder& holder, double s_min, double s_max) {
   DeformableBodySettings settings;
   settings.name = "block";
   settings.material = {2e4, 0.3, 1000.0};
@@ -460,9 +460,15 @@ BoxOnBlock RestBoxOnBlock(IslandSolverKind solver) {
   DeformableBody* block =
       holder.world.AddTetBody(MakeBoxTetMesh(Vec3(0.2, 0.2, 0.1), 4, 4, 2), settings);
   block->FixNodesWhere([](const Vec3& X) { return X.z() < 1e-9; });
-  holder.world.SetStrainLimits(block, StrainLimitSettings::Isotropic(0.95, 1.05));
-  btRigidBody* box = holder.AddRigidBody(std::make_unique<btBoxShape>(btVector3(0.06, 0.06, 0.05)),
-                                         2.0, btVector3(0.1, 0.1, 0.1505));
+  holder.world.SetStrainLimits(block, StrainLimitSettings::Isotropic(s_min, s_max));
+  return holder.AddRigidBody(std::make_unique<btBoxShape>(btVector3(0.06, 0.06, 0.05)), 2.0,
+                             btVector3(0.1, 0.1, 0.1505));
+}
+
+BoxOnBlock RestBoxOnBlock(IslandSolverKind solver) {
+  BulletWorldHolder holder;
+  holder.world.mutable_solver_settings().solver = solver;
+  btRigidBody* box = AddBoxOnLimitedBlock(holder, 0.95, 1.05);
   BoxOnBlock result;
   for (int step = 0; step < 480; ++step) {
     holder.world.stepSimulation(1.0 / 240, 1, 1.0 / 240);
@@ -522,16 +528,7 @@ TEST(PrimalSolverTest, CertifiedStepWarmStartsTheNextFromTheMultipliersItReports
   // collapsing columns worse). Storing lambda_bar everywhere, as before, fails this on 2,791 rows.
   BulletWorldHolder holder;
   holder.world.mutable_solver_settings().solver = IslandSolverKind::kPrimal;
-  DeformableBodySettings settings;
-  settings.name = "block";
-  settings.material = {2e4, 0.3, 1000.0};
-  settings.mass_damping = 2.0;
-  DeformableBody* block =
-      holder.world.AddTetBody(MakeBoxTetMesh(Vec3(0.2, 0.2, 0.1), 4, 4, 2), settings);
-  block->FixNodesWhere([](const Vec3& X) { return X.z() < 1e-9; });
-  holder.world.SetStrainLimits(block, StrainLimitSettings::Isotropic(0.96, 1.04));
-  holder.AddRigidBody(std::make_unique<btBoxShape>(btVector3(0.06, 0.06, 0.05)), 2.0,
-                      btVector3(0.1, 0.1, 0.1505));
+  AddBoxOnLimitedBlock(holder, 0.96, 1.04);
   const double tolerance = holder.world.solver_settings().violation_tolerance;
   int certified_steps = 0, rows_at_bound = 0, mismatches = 0;
   for (int step = 0; step < 120; ++step) {
