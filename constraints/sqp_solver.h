@@ -18,6 +18,11 @@
 
 namespace taut {
 
+// PGS tolerance (w units, 1/s) of a QP at step h: settings.pgs.tolerance, and from the
+// warm-start velocity at most warm_stop_distance_factor * contact_tolerance / (2 h), so that one
+// QP leaves the distance rows as tight as the warm stop asks (docs/math.md §5.7).
+double CalcQpPgsTolerance(double h, bool warm_started, const SqpSettings& settings);
+
 // Solves min 1/2 (v - v*)^T A (v - v*) s.t. C(x0 + h v) >= 0 for the bodies of one island:
 //   for k = 0, 1, ...: rows and J_k at x_k = x0 + h v_k; W = J_k A^-1 J_k^T;
 //   q = C(x_k)/h + J_k (v* - v_k); PGS from lambda_k -> lambda_QP; v_QP = v* + A^-1 J_k^T
@@ -72,8 +77,9 @@ class SqpSolver {
   // The QP at the iterate: W, q = C/h + J (v* - v_k) (restoration: C/h), the PGS rows and the
   // starting lambda_QP.
   void BuildQp(double h, const std::vector<IslandBody*>& bodies, bool restoring);
-  // lambda_QP by one PGS (and the active-set polish where PGS left a residual).
-  void SolveQp(const SqpSettings& settings, StepStats& stats);
+  // lambda_QP by one PGS (and the active-set polish where PGS left a residual), to
+  // CalcQpPgsTolerance.
+  void SolveQp(double h, const SqpSettings& settings, StepStats& stats);
   // v_QP from lambda_QP.
   void CalcQpVelocities(const std::vector<IslandBody*>& bodies, bool restoring);
   // Rows at the full QP step v_QP that the QP lacked and v_QP violates join rows_, linearized
