@@ -7,17 +7,22 @@
 //   ldlt        SparseLdlt (taut's LDL^T, its ordering chosen: AMD, or nested dissection for large
 //               bodies where it fills less): the default build's backend
 //   ldlt_amd    SparseLdlt with AMD forced (the ordering before nested dissection, for the ratio)
+//   ldlt_2threads  SparseLdlt factoring on two threads where its supernodal factor splits (the
+//               same factor bit for bit; the ratio to ldlt is the 2-core speed-up of Factorize)
 //   eigen_llt   Eigen's SimplicialLLT (AMD ordering)
 //   cholmod     CHOLMOD's supernodal LL^T (only in builds with -DTAUT_WITH_CHOLMOD=ON, GPL-2+)
 // op: factor_solve (numeric factorization + one solve, what every step does) or solve64 (64
 // right-hand sides, the A^-1 J^T columns). Counters: dofs, elements, nnz_L (entries of L),
 // rel_diff, the relative difference of the solution to ldlt's, and (SparseLdlt) nested_dissection,
-// 1 when its ordering is nested dissection, and factor_work, its multiply-adds per factorization.
+// 1 when its ordering is nested dissection, factor_work, its multiply-adds per factorization, and
+// split_share, the share of the supernodal factor's work in the two groups that ldlt_2threads
+// factors in parallel (0: no split).
 //   taut_bench --benchmark_filter=BM_Factorization
 #include <benchmark/benchmark.h>
 
 #include <Eigen/SparseCholesky>
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -29,6 +34,7 @@
 #include <utility>
 #include <vector>
 
+#include "bullet_bridge/island_thread_pool.h"
 #include "plugin/box_tet_mesher.h"
 #include "plugin/cholmod_cholesky.h"
 #include "plugin/hex_element_model.h"
@@ -181,6 +187,15 @@ class AmdLdlt : public SparseLdlt {
   void Analyze(const SparseMatrix& A) { SparseLdlt::Analyze(A, Kernel::kAuto, Ordering::kAmd); }
 };
 
+// SparseLdlt factoring on two threads (SupernodalCholesky's two-way split).
+class TwoThreadLdlt : public SparseLdlt {
+ public:
+  bool Factorize(const SparseMatrix& A) { return SparseLdlt::Factorize(A, &pool_); }
+
+ private:
+  IslandThreadPool pool_{2};
+};
+
 // 1 when the backend ordered by nested dissection (SparseLdlt), else 0.
 double UsesNestedDissection(const SparseLdlt& s) {
   return s.ordering() == SparseLdlt::Ordering::kNestedDissection ? 1.0 : 0.0;
@@ -190,6 +205,14 @@ double UsesNestedDissection(const EigenLlt&) { return 0.0; }
 
 // Multiply-adds of one factorization (SparseLdlt::CalcFactorWork; 0 for the other backends).
 double FactorWork(const SparseLdlt& s) { return s.CalcFactorWork(); }
+// Share of the supernodal factor's estimated work in its two subtree groups (0 without a split).
+double SplitShare(const SparseLdlt& s) {
+  if (!s.supernodal() || !s.supernodal_factor().has_two_way_split()) return 0.0;
+  const std::array<double, 3>& w = s.supernodal_factor().split_work();
+  return (w[0] + w[1]) / (w[0] + w[1] + w[2]);
+}
+double SplitShare(const CholmodCholesky&) { return 0.0; }
+double SplitShare(const EigenLlt&) { return 0.0; }
 double FactorWork(const CholmodCholesky&) { return 0.0; }
 double FactorWork(const EigenLlt&) { return 0.0; }
 
@@ -235,15 +258,21 @@ void RunBackend(benchmark::State& state, Solver& solver, Op op, const CaseSpec& 
   state.counters["rel_diff"] = diff;
   state.counters["nested_dissection"] = UsesNestedDissection(solver);
   state.counters["factor_work"] = FactorWork(solver);
+  state.counters["split_share"] = SplitShare(solver);
 }
 
 // The backends.
-enum class Backend { kLdlt, kLdltAmd, kEigenLlt, kCholmod };
+enum class Backend { kLdlt, kLdlt2Threads, kLdltAmd, kEigenLlt, kCholmod };
 
 void BM_Factor(benchmark::State& state, Op op, CaseSpec spec, Backend backend) {
   switch (backend) {
     case Backend::kLdlt: {
       SparseLdlt s;
+      RunBackend(state, s, op, spec);
+      break;
+    }
+    case Backend::kLdlt2Threads: {
+      TwoThreadLdlt s;
       RunBackend(state, s, op, spec);
       break;
     }
@@ -285,7 +314,10 @@ const bool kRegistered = [] {
   if (std::filesystem::exists(ArmadilloPath()))
     cases.push_back({"armadillo", {false, 0, 0, 0, true}});
   std::vector<std::pair<Backend, const char*>> backends = {
-      {Backend::kLdlt, "ldlt"}, {Backend::kLdltAmd, "ldlt_amd"}, {Backend::kEigenLlt, "eigen_llt"}};
+      {Backend::kLdlt, "ldlt"},
+      {Backend::kLdlt2Threads, "ldlt_2threads"},
+      {Backend::kLdltAmd, "ldlt_amd"},
+      {Backend::kEigenLlt, "eigen_llt"}};
   if (IsCholmodAvailable()) backends.push_back({Backend::kCholmod, "cholmod"});
   for (const auto& [op, op_name] :
        {std::pair{Op::kFactorSolve, "factor_solve"}, std::pair{Op::kSolve64, "solve64"}})
@@ -293,6 +325,8 @@ const bool kRegistered = [] {
       for (const auto& [backend, backend_name] : backends) {
         // 100k tets: the simplicial backends take ~20 s per factorization; SparseLdlt only.
         if (std::string(c.name) == "tet_100k" && backend == Backend::kEigenLlt) continue;
+        // The solves are the same on two threads.
+        if (op == Op::kSolve64 && backend == Backend::kLdlt2Threads) continue;
         benchmark::RegisterBenchmark(
             (std::string("BM_Factorization/") + op_name + "/" + c.name + "/" + backend_name)
                 .c_str(),

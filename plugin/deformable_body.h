@@ -90,8 +90,12 @@ class DeformableBody {
   void AddNodeForce(int node, const Vec3& force);
 
   // Threads that split this body's element loops in BeginStep (rotations, forces, the system's
-  // assembly; null: the calling thread). Results are bitwise the same for any runner.
-  void set_element_loop_runner(ElementLoopRunner* runner) { model_->set_loop_runner(runner); }
+  // assembly and factorization; null: the calling thread). Results are bitwise the same for any
+  // runner.
+  void set_element_loop_runner(ElementLoopRunner* runner) {
+    model_->set_loop_runner(runner);
+    system_.set_loop_runner(runner);
+  }
 
   // Builds the system's sparsity pattern for the current node kinds and its symbolic
   // factorization (ordering, elimination tree, supernodes) now instead of in the next BeginStep,

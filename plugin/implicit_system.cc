@@ -84,7 +84,8 @@ void ImplicitSystem::Assemble(const ElementModel& model, const VecX& mass, doubl
 
 bool ImplicitSystem::FactorWith(const Eigen::SparseMatrix<double>& M, SparseLdlt& ldlt,
                                 CholmodCholesky& cholmod) const {
-  return use_cholmod_ ? cholmod.Factorize(M) : ldlt.Factorize(M) && ldlt.num_negative_pivots() == 0;
+  return use_cholmod_ ? cholmod.Factorize(M)
+                      : ldlt.Factorize(M, loop_runner_) && ldlt.num_negative_pivots() == 0;
 }
 
 void ImplicitSystem::SolveWith(const SparseLdlt& ldlt, const CholmodCholesky& cholmod,

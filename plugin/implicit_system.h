@@ -138,6 +138,12 @@ class ImplicitSystem {
     bool exact_solves = false;  // the last step's constraint solve needed this step's A^-1
   };
   NewtonState SaveNewtonState() const;
+
+  // Threads for the factorizations (null: the calling thread): a large SparseLdlt factor splits
+  // over two of them, bitwise the same (SupernodalCholesky::Factorize). Not part of the state.
+  void set_loop_runner(ElementLoopRunner* runner) { loop_runner_ = runner; }
+  // The SparseLdlt factor of A (empty when the backend is CHOLMOD).
+  const SparseLdlt& sparse_ldlt() const { return ldlt_; }
   // The same into `state`, reusing its storage (no allocation once it has held a state of this
   // system). H and factor are left as they were when `analyzed` comes out false: unused then.
   void SaveNewtonState(NewtonState& state) const;
@@ -157,7 +163,8 @@ class ImplicitSystem {
   SparseLdlt ldlt_;              // the factor when !use_cholmod_
   CholmodCholesky cholmod_;      // the factor when use_cholmod_
   bool factor_current_ = false;  // the factor is of A's values (not an earlier step's A)
-  bool exact_solves_ = false;    // EnsureCurrentFactor was called since the last SolveStep
+  ElementLoopRunner* loop_runner_ = nullptr;  // set_loop_runner
+  bool exact_solves_ = false;  // EnsureCurrentFactor was called since the last SolveStep
   // Cost of factoring A in PCG iterations with the held factor (4 nnz(L) + 2 nnz(A) flops each),
   // 0 without a SparseLdlt factor.
   double CalcRefactorCost(const SparseLdlt& factor) const;

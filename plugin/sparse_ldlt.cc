@@ -147,7 +147,7 @@ void SparseLdlt::CalcEliminationTree() {
 }
 
 // Up-looking numeric phase: row k of L and d_k from column k of C, for k = 0..n-1.
-bool SparseLdlt::Factorize(const SparseMatrix& A) {
+bool SparseLdlt::Factorize(const SparseMatrix& A, ElementLoopRunner* runner) {
   TAUT_DEMAND(analyzed_, "SparseLdlt::Factorize called before Analyze");
   TAUT_DEMAND(A.rows() == n_ && A.cols() == n_ && A.isCompressed() &&
                   A.nonZeros() == static_cast<Eigen::Index>(a_inner_.size()) &&
@@ -161,7 +161,7 @@ bool SparseLdlt::Factorize(const SparseMatrix& A) {
   num_negative_pivots_ = 0;
   const double* a_val = A.valuePtr();
   if (supernodal_) {
-    if (!supernodal_factor_.Factorize(a_val)) {
+    if (!supernodal_factor_.Factorize(a_val, runner)) {
       failed_column_ = perm_[supernodal_factor_.failed_column()];
       num_negative_pivots_ = supernodal_factor_.failed_pivot_negative() ? 1 : 0;
       return false;

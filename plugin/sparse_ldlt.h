@@ -62,6 +62,8 @@ class SparseLdlt {
                Ordering ordering = Ordering::kAuto);
   // True when Analyze chose (or was given) the supernodal kernel.
   bool supernodal() const { return supernodal_; }
+  // The supernodal kernel's factor (its split, plugin/supernodal_cholesky.h).
+  const SupernodalCholesky& supernodal_factor() const { return supernodal_factor_; }
   // The ordering Analyze chose (kAmd or kNestedDissection).
   Ordering ordering() const { return ordering_; }
 
@@ -69,8 +71,10 @@ class SparseLdlt {
   // row indices are compared in debug builds). No heap allocation (the supernodal kernel's dense
   // products allocate a few work blocks). Returns false when a pivot is
   // zero or not finite; failed_column() then names the column of A. Throws InputError when called
-  // before Analyze or with a different size or nonzero count.
-  bool Factorize(const SparseMatrix& A);
+  // before Analyze or with a different size or nonzero count. A runner of two or more threads
+  // factors the supernodal kernel's two subtree groups in parallel (SupernodalCholesky::Factorize;
+  // bitwise the same factor).
+  bool Factorize(const SparseMatrix& A, ElementLoopRunner* runner = nullptr);
 
   // Solves A x = b in place (b := x). No heap allocation. Throws InputError without a successful
   // Factorize or when b has the wrong size.

@@ -175,15 +175,94 @@ void SupernodalCholesky::BuildScatterMap(const std::vector<int>& c_start,
     for (int k = 0; k < rows_in(s); ++k) pos[rows_[row_start_[s] + k]] = -1;
   }
 
-  map_.assign(n_, 0);
   head_.assign(num_sn, -1);
   next_.assign(num_sn, -1);
   next_row_.assign(num_sn, 0);
-  update_.assign(static_cast<size_t>(max_rows) * max_width, 0.0);
+  FindTwoWaySplit();
+  for (int g = 0; g < (has_split_ ? 2 : 1); ++g) {
+    workspaces_[g].map.assign(n_, 0);
+    workspaces_[g].update.assign(static_cast<size_t>(max_rows) * max_width, 0.0);
+  }
   solve_work_.assign(static_cast<size_t>(max_rows) * kMaxSolveColumns, 0.0);
 }
 
-bool SupernodalCholesky::Factorize(const double* a_val) {
+void SupernodalCholesky::FindTwoWaySplit() {
+  const int num_sn = num_supernodes();
+  has_split_ = false;
+  split_work_ = {0.0, 0.0, 0.0};
+  group_nodes_[0].clear();
+  group_nodes_[1].clear();
+  top_nodes_.clear();
+  group_of_.assign(num_sn, 2);
+  // Supernodal etree (a panel's parent owns its first row below the diagonal block) and the work
+  // of each subtree: w^3 / 3 for the diagonal block, w^2 b for the rows below, w b^2 / 2 for the
+  // updates it sends (b = rows below).
+  std::vector<int> child_head(num_sn, -1), child_next(num_sn, -1), roots;
+  std::vector<double> subtree_work(num_sn, 0.0);
+  double total = 0.0;
+  for (int s = 0; s < num_sn; ++s) {
+    const double w = width(s), b = rows_in(s) - width(s);
+    subtree_work[s] += w * w * w / 3.0 + w * w * b + 0.5 * w * b * b;
+    total += w * w * w / 3.0 + w * w * b + 0.5 * w * b * b;
+    if (rows_in(s) > width(s)) {
+      const int p = sn_of_[rows_[row_start_[s] + width(s)]];
+      subtree_work[p] += subtree_work[s];  // p > s: children come first
+      child_next[s] = child_head[p];
+      child_head[p] = s;
+    } else {
+      roots.push_back(s);
+    }
+  }
+  if (total < kMinSplitWork) return;
+  // A frontier of disjoint subtrees, in two groups by largest-first into the lighter; its
+  // estimated time is that of the heavier group plus the supernodes above. From the roots, the
+  // heaviest subtree of the frontier is replaced by its children (its own supernode joins those
+  // above) while that lowers the estimate, up to kMaxSplitRefinements times.
+  auto assign = [&](std::vector<int>& frontier, std::array<double, 2>& work) {
+    std::sort(frontier.begin(), frontier.end(), [&](int a, int b) {
+      return subtree_work[a] > subtree_work[b] || (subtree_work[a] == subtree_work[b] && a < b);
+    });
+    work = {0.0, 0.0};
+    for (const int s : frontier) work[work[1] < work[0] ? 1 : 0] += subtree_work[s];
+    return std::max(work[0], work[1]) + (total - work[0] - work[1]);
+  };
+  std::vector<int> frontier = roots, best_frontier;
+  std::array<double, 2> work{}, best_work{};
+  double best_time = total;
+  for (int refinement = 0; refinement <= kMaxSplitRefinements && !frontier.empty(); ++refinement) {
+    const double time = assign(frontier, work);
+    if (frontier.size() >= 2 && time < best_time) {
+      best_time = time;
+      best_frontier = frontier;
+      best_work = work;
+    }
+    const int heaviest = frontier.front();
+    if (child_head[heaviest] == -1) break;
+    frontier.erase(frontier.begin());
+    for (int c = child_head[heaviest]; c != -1; c = child_next[c]) frontier.push_back(c);
+  }
+  if (best_frontier.empty() || std::min(best_work[0], best_work[1]) < kMinGroupShare * total)
+    return;
+  work = {0.0, 0.0};
+  std::vector<int> stack;
+  for (const int branch : best_frontier) {
+    const int g = work[1] < work[0] ? 1 : 0;
+    work[g] += subtree_work[branch];
+    stack.assign(1, branch);
+    while (!stack.empty()) {
+      const int s = stack.back();
+      stack.pop_back();
+      group_of_[s] = g;
+      for (int c = child_head[s]; c != -1; c = child_next[c]) stack.push_back(c);
+    }
+  }
+  for (int s = 0; s < num_sn; ++s)
+    (group_of_[s] == 2 ? top_nodes_ : group_nodes_[group_of_[s]]).push_back(s);
+  split_work_ = {work[0], work[1], total - work[0] - work[1]};
+  has_split_ = true;
+}
+
+bool SupernodalCholesky::Factorize(const double* a_val, ElementLoopRunner* runner) {
   failed_column_ = -1;
   failed_pivot_negative_ = false;
   single_current_ = false;
@@ -191,66 +270,137 @@ bool SupernodalCholesky::Factorize(const double* a_val) {
   for (size_t q = 0; q < entry_dest_.size(); ++q)
     values_[entry_dest_[q]] += a_val[entry_source_[q]];
   std::fill(head_.begin(), head_.end(), -1);
-  const int num_sn = num_supernodes();
-  for (int t = 0; t < num_sn; ++t) {
-    const int* rows_t = rows_.data() + row_start_[t];
-    for (int k = 0; k < rows_in(t); ++k) map_[rows_t[k]] = k;
-    // Step 2: every descendant whose next unconsumed row is one of t's columns.
-    for (int d = head_[t], after = 0; d != -1; d = after) {
-      after = next_[d];
-      const int* rows_d = rows_.data() + row_start_[d];
-      const int k1 = next_row_[d];
-      int k2 = k1;
-      while (k2 < rows_in(d) && rows_d[k2] < sn_start_[t + 1]) ++k2;
-      SubtractUpdate(d, k1, k2, t);
-      next_row_[d] = k2;
-      if (k2 < rows_in(d)) {
-        const int p = sn_of_[rows_d[k2]];
-        next_[d] = head_[p];
-        head_[p] = d;
-      }
-    }
-    if (!FactorPanel(t)) return false;
-    if (rows_in(t) > width(t)) {
-      next_row_[t] = width(t);
-      const int p = sn_of_[rows_t[width(t)]];
-      next_[t] = head_[p];
-      head_[p] = t;
-    }
+  FailedPivot failed;
+  const bool ok = has_split_ && runner != nullptr && runner->num_loop_threads() >= 2
+                      ? FactorOnTwoThreads(*runner, failed)
+                      : FactorSerially(workspaces_[0], failed);
+  if (!ok) {
+    failed_column_ = failed.column;
+    failed_pivot_negative_ = failed.negative;
+  }
+  return ok;
+}
+
+template <typename Link>
+bool SupernodalCholesky::FactorSupernode(int t, Workspace& ws, Link& link, FailedPivot& failed) {
+  const int* rows_t = rows_.data() + row_start_[t];
+  for (int k = 0; k < rows_in(t); ++k) ws.map[rows_t[k]] = k;
+  // Step 2: every descendant whose next unconsumed row is one of t's columns.
+  for (int d = head_[t], after = 0; d != -1; d = after) {
+    after = next_[d];
+    const int* rows_d = rows_.data() + row_start_[d];
+    const int k1 = next_row_[d];
+    int k2 = k1;
+    while (k2 < rows_in(d) && rows_d[k2] < sn_start_[t + 1]) ++k2;
+    SubtractUpdate(d, k1, k2, t, ws);
+    next_row_[d] = k2;
+    if (k2 < rows_in(d)) link(d, sn_of_[rows_d[k2]]);
+  }
+  if (!FactorPanel(t, failed)) return false;
+  if (rows_in(t) > width(t)) {
+    next_row_[t] = width(t);
+    link(t, sn_of_[rows_t[width(t)]]);
   }
   return true;
 }
 
+bool SupernodalCholesky::FactorSerially(Workspace& ws, FailedPivot& failed) {
+  auto link = [this](int d, int p) {
+    next_[d] = head_[p];
+    head_[p] = d;
+  };
+  for (int t = 0; t < num_supernodes(); ++t)
+    if (!FactorSupernode(t, ws, link, failed)) return false;
+  return true;
+}
+
+// The serial order of the links into each list is that of the supernode t being factored when
+// they were made (ascending t): a thread links into its own group's lists directly (only its own
+// supernodes link there), and the links into the lists above the groups are applied after both
+// threads, in ascending t, interleaved with the supernodes above by index. So every list, and
+// with it the order of every supernode's updates, is the serial one.
+bool SupernodalCholesky::FactorOnTwoThreads(ElementLoopRunner& runner, FailedPivot& failed) {
+  constexpr int kNone = std::numeric_limits<int>::max();
+  std::array<FailedPivot, 2> group_failed;
+  std::array<int, 2> failed_at{kNone, kNone};
+  auto factor_group = [&](int g) {
+    deferred_[g].clear();
+    for (const int t : group_nodes_[g]) {
+      auto link = [&](int d, int p) {
+        if (group_of_[p] == g) {
+          next_[d] = head_[p];
+          head_[p] = d;
+        } else {
+          deferred_[g].push_back({t, d, p});
+        }
+      };
+      if (!FactorSupernode(t, workspaces_[g], link, group_failed[g])) {
+        failed_at[g] = t;
+        return;
+      }
+    }
+  };
+  runner.RunChunks(2, factor_group);
+  // The links of both threads in ascending t, each applied before the first supernode above
+  // the groups that comes after its t (links only go to later supernodes).
+  size_t i = 0, j = 0;
+  const std::vector<DeferredLink>& a = deferred_[0];
+  const std::vector<DeferredLink>& b = deferred_[1];
+  auto apply_links_before = [&](int u) {
+    while ((i < a.size() && a[i].t < u) || (j < b.size() && b[j].t < u)) {
+      const DeferredLink& next =
+          j == b.size() || (i < a.size() && a[i].t < b[j].t) ? a[i++] : b[j++];
+      next_[next.d] = head_[next.p];
+      head_[next.p] = next.d;
+    }
+  };
+  auto link = [this](int d, int p) {
+    next_[d] = head_[p];
+    head_[p] = d;
+  };
+  // After a failure in a group the serial loop would still have factored (and may have failed at)
+  // the supernodes above the groups that come before it; none after it.
+  const int group_failure = std::min(failed_at[0], failed_at[1]);
+  for (const int t : top_nodes_) {
+    if (t > group_failure) break;
+    apply_links_before(t);
+    if (!FactorSupernode(t, workspaces_[0], link, failed)) return false;
+  }
+  if (group_failure == kNone) return true;
+  failed = group_failed[failed_at[0] < failed_at[1] ? 0 : 1];
+  return false;
+}
+
 // Panel_t(rows_d[i], rows_d[j]) -= sum_c L_d(i, c) L_d(j, c) for k1 <= j < k2, i >= j.
-void SupernodalCholesky::SubtractUpdate(int d, int k1, int k2, int t) {
+void SupernodalCholesky::SubtractUpdate(int d, int k1, int k2, int t, Workspace& ws) {
   const double* l_d = values_.data() + val_start_[d];
   const int n1 = k2 - k1, n2 = rows_in(d) - k1;
   ActiveDenseKernels().multiply_by_transposed(l_d + k1, rows_in(d), l_d + k1, rows_in(d), n2, n1,
-                                              width(d), update_.data(), n2);
-  const Panel update(update_.data(), n2, n1);
+                                              width(d), ws.update.data(), n2);
+  const Panel update(ws.update.data(), n2, n1);
   const int* rows_d = rows_.data() + row_start_[d];
   Panel l_t = panel(t);
   const int first_t = sn_start_[t];
   for (int j = 0; j < n1; ++j) {
     double* col = l_t.col(rows_d[k1 + j] - first_t).data();
-    for (int i = j; i < n2; ++i) col[map_[rows_d[k1 + i]]] -= update(i, j);
+    for (int i = j; i < n2; ++i) col[ws.map[rows_d[k1 + i]]] -= update(i, j);
   }
 }
 
 // L_tt L_tt^T = diagonal block (blocked in-place Cholesky); L_below = below L_tt^-T.
-bool SupernodalCholesky::FactorPanel(int t) {
+bool SupernodalCholesky::FactorPanel(int t, FailedPivot& failed) {
   const DenseKernels& kernels = ActiveDenseKernels();
   double* l_t = values_.data() + val_start_[t];
   const int w = width(t), m = rows_in(t);
-  const int failed = kernels.cholesky_lower(l_t, m, w);
-  if (failed >= 0) {
-    failed_column_ = sn_start_[t] + failed;
-    failed_pivot_negative_ = true;
+  const int failed_at = kernels.cholesky_lower(l_t, m, w);
+  if (failed_at >= 0) {
+    failed.column = sn_start_[t] + failed_at;
+    failed.negative = true;
     return false;
   }
   for (int k = 0; k < w; ++k)
     if (!std::isfinite(l_t[k * m + k])) {
-      failed_column_ = sn_start_[t] + k;
+      failed.column = sn_start_[t] + k;
       return false;
     }
   if (m > w) kernels.solve_right_lower_transposed(l_t, m, w, l_t + w, m, m - w);

@@ -2,9 +2,11 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <array>
 #include <vector>
 
 #include "plugin/common.h"
+#include "plugin/element_loop_runner.h"
 
 namespace taut {
 
@@ -35,8 +37,11 @@ class SupernodalCholesky {
 
   // Numeric phase with A's values (the pattern Analyze saw). Returns false when a pivot is not
   // positive and finite; failed_column() then names the permuted column (-1 otherwise) and
-  // failed_pivot_negative() whether that pivot was negative.
-  bool Factorize(const double* a_val);
+  // failed_pivot_negative() whether that pivot was negative. With a runner of two or more threads
+  // and a split from Analyze (has_two_way_split), the two groups of subtrees factor on two
+  // threads, then the supernodes above them: the same operations in the same order per supernode,
+  // so L is bitwise that of one thread.
+  bool Factorize(const double* a_val, ElementLoopRunner* runner = nullptr);
 
   // Solves C X = Y in place for a row-major (n x width) block Y (permuted order).
   void Solve(double* y, int width) const;
@@ -58,6 +63,17 @@ class SupernodalCholesky {
   void CalcPivots(std::vector<double>& d) const;
 
   int num_supernodes() const { return static_cast<int>(sn_start_.size()) - 1; }
+  // True when Analyze found two groups of independent subtrees worth factoring in parallel.
+  bool has_two_way_split() const { return has_split_; }
+  // Estimated factor work (multiply-adds) of the two groups and of the supernodes above them.
+  const std::array<double, 3>& split_work() const { return split_work_; }
+
+  // Factor work from which Analyze looks for a two-way split, and the least share of it each
+  // group must carry (measured on 2 cores: below them the threads' hand-over costs more than the
+  // split saves).
+  static constexpr double kMinSplitWork = 5e6;
+  static constexpr double kMinGroupShare = 0.2;
+  static constexpr int kMaxSplitRefinements = 32;
   int failed_column() const { return failed_column_; }
   bool failed_pivot_negative() const { return failed_pivot_negative_; }
 
@@ -80,11 +96,38 @@ class SupernodalCholesky {
   // Where each entry of C lands in the panel storage, and the size of every workspace.
   void BuildScatterMap(const std::vector<int>& c_start, const std::vector<int>& c_row,
                        const std::vector<int>& c_source);
+  // Groups of subtrees for two threads: disjoint subtrees in two groups of about equal work
+  // (largest first into the lighter group), found by splitting the heaviest subtree from the
+  // roots down while the estimated time falls; the supernodes above them (ancestors of the
+  // groups) stay on one thread after them.
+  void FindTwoWaySplit();
+
+  // A thread's scratch for steps 2-3: relative row positions in the current panel (n) and the
+  // update product (max rows x max width).
+  struct Workspace {
+    std::vector<int> map;
+    std::vector<double> update;
+  };
+  // A pivot that was not positive and finite.
+  struct FailedPivot {
+    int column = -1;
+    bool negative = false;
+  };
+  // d joins the list of descendants waiting for supernode p while supernode t is factored (a
+  // link into a list above the groups, applied after both threads in the order of t).
+  struct DeferredLink {
+    int t, d, p;
+  };
+  // Steps 2 and 3 for supernode t; link(d, p) puts d on p's list of waiting descendants.
+  template <typename Link>
+  bool FactorSupernode(int t, Workspace& ws, Link& link, FailedPivot& failed);
+  bool FactorSerially(Workspace& ws, FailedPivot& failed);
+  bool FactorOnTwoThreads(ElementLoopRunner& runner, FailedPivot& failed);
   // Step 2 for one descendant d of t: rows [k1, m_d) of d's panel against rows [k1, k2).
-  void SubtractUpdate(int d, int k1, int k2, int t);
+  void SubtractUpdate(int d, int k1, int k2, int t, Workspace& ws);
   // Step 3: dense Cholesky of t's diagonal block and the triangular solve below it (steps 2-3
   // and the solves run on the CPU's dense kernel set, plugin/dense_kernels.h).
-  bool FactorPanel(int t);
+  bool FactorPanel(int t, FailedPivot& failed);
 
   Panel panel(int s) { return Panel(values_.data() + val_start_[s], rows_in(s), width(s)); }
   ConstPanel read_panel(int s) const {
@@ -109,11 +152,19 @@ class SupernodalCholesky {
 
   // Factorize workspace: relative row positions in the current panel, the linked lists of
   // descendants waiting for each supernode, each descendant's next row, the update product.
-  std::vector<int> map_;        // (n)
-  std::vector<int> head_;       // (S) first descendant waiting for supernode t, -1 if none
-  std::vector<int> next_;       // (S) next descendant in the same list
-  std::vector<int> next_row_;   // (S) index in d's rows of its first row not yet consumed
-  std::vector<double> update_;  // (max rows x max width)
+  std::array<Workspace, 2> workspaces_;  // [0]: one thread and the top; [1]: the second thread
+  std::vector<int> head_;                // (S) first descendant waiting for supernode t, -1 if none
+  std::vector<int> next_;                // (S) next descendant in the same list
+  std::vector<int> next_row_;            // (S) index in d's rows of its first row not yet consumed
+
+  // The two-way split (FindTwoWaySplit): each group's supernodes ascending, the rest ascending,
+  // the group of every supernode (0, 1; 2 above the groups), links deferred by each thread.
+  bool has_split_ = false;
+  std::array<double, 3> split_work_{};
+  std::array<std::vector<int>, 2> group_nodes_;
+  std::vector<int> top_nodes_;
+  std::vector<int> group_of_;
+  std::array<std::vector<DeferredLink>, 2> deferred_;
   mutable std::vector<double> solve_work_;  // (max rows x kMaxSolveColumns)
 
   int failed_column_ = -1;

@@ -177,9 +177,13 @@ if orderings:
             "Numeric factorization + one solve of A = M + h^2 K (bench/factorization_bench.cc, "
             "manual time): SparseLdlt with its chosen ordering (nested dissection where it gives "
             "L less factor work and no more nonzeros than AMD, from 3e7 multiply-adds of AMD work) "
-            "against AMD forced, in the same run.", "",
+            "against AMD forced, in the same run; and the chosen ordering's factor on two "
+            "threads (ldlt_2threads: its supernodal factor's two groups of subtrees in parallel, "
+            "then the supernodes above them, bitwise the same factor; split: the share of the "
+            "estimated work in the two groups, 0 where the factor does not split).", "",
             "| case | DOFs | chosen | ms (chosen) | ms (AMD) | AMD / chosen | nnz(L) chosen | "
-            "nnz(L) AMD |", "|---|---:|---|---:|---:|---:|---:|---:|"]
+            "nnz(L) AMD | ms (2 threads) | 1 / 2 threads | split |",
+            "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
     to_ms = {"ns": 1e-6, "us": 1e-3, "ms": 1.0, "s": 1e3}
     for n, b in orderings:
         amd = median.get(n + "_amd")
@@ -188,9 +192,13 @@ if orderings:
         chosen_ms = b["real_time"] * to_ms[b["time_unit"]]
         amd_ms = amd["real_time"] * to_ms[amd["time_unit"]]
         chosen = "nested dissection" if b.get("nested_dissection", 0) > 0.5 else "AMD"
+        two = median.get(n + "_2threads")
+        two_ms = two["real_time"] * to_ms[two["time_unit"]] if two else None
         out.append(f"| {n.split('/')[2]} | {int(b['dofs'])} | {chosen} | {fmt(chosen_ms)} | "
                    f"{fmt(amd_ms)} | {fmt(amd_ms / chosen_ms)} | {int(b['nnz_L'])} | "
-                   f"{int(amd['nnz_L'])} |")
+                   f"{int(amd['nnz_L'])} | {fmt(two_ms) if two else '–'} | "
+                   f"{fmt(chosen_ms / two_ms) if two else '–'} | "
+                   f"{fmt(b.get('split_share', 0.0))} |")
 
 shapes = ["sphere", "box", "capsule", "cylinder", "hull"]
 methods = []

@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "bullet_bridge/island_thread_pool.h"
 #include "plugin/box_tet_mesher.h"
 #include "plugin/sparse_ldlt.h"
 #include "tests/tet_block_spd.h"
@@ -134,6 +135,52 @@ TEST(SupernodalCholeskyTest, SinglePrecisionSolveInvertsTheRoundedFactor) {
   VecX x_after = B.col(0);
   sn.SolveSinglePrecision(x_after);
   EXPECT_EQ(x_after, x_double);
+}
+
+// Two threads factor the two groups of subtrees below the first branching, then the supernodes
+// above: the same pivots and solves bit for bit as one thread, and the same failed column.
+TEST(SupernodalCholeskyTest, TwoThreadsFactorBitwiseLikeOne) {
+  const SnSparse A = testing::MakeRandomTetBlockSpd(14, 10, 8, 21);
+  SparseLdlt one, two;
+  one.Analyze(A, SparseLdlt::Kernel::kSupernodal);
+  two.Analyze(A, SparseLdlt::Kernel::kSupernodal);
+  IslandThreadPool pool(2);
+  ASSERT_TRUE(one.Factorize(A));
+  ASSERT_TRUE(two.Factorize(A, &pool));
+  EXPECT_EQ(one.pivots(), two.pivots());
+  const MatX B = MakeSnRhs(static_cast<int>(A.rows()), 3, 22);
+  MatX X_one = B, X_two = B;
+  one.SolveColumns(X_one);
+  two.SolveColumns(X_two);
+  EXPECT_EQ(X_one, X_two);
+  EXPECT_LT((A * X_two - B).norm(), 1e-12 * A.norm() * X_two.norm());
+  // An indefinite A fails at the same column on both.
+  SnSparse indefinite = A;
+  for (int k = 0; k < indefinite.outerSize(); ++k)
+    for (SnSparse::InnerIterator it(indefinite, k); it; ++it)
+      if (it.row() == it.col()) it.valueRef() -= 1.0e3;
+  EXPECT_FALSE(one.Factorize(indefinite));
+  EXPECT_FALSE(two.Factorize(indefinite, &pool));
+  EXPECT_EQ(one.failed_column(), two.failed_column());
+  EXPECT_EQ(one.num_negative_pivots(), two.num_negative_pivots());
+}
+
+// The split itself: both groups carry at least kMinGroupShare of the work, and the factor of a
+// matrix below kMinSplitWork is not split.
+TEST(SupernodalCholeskyTest, TwoWaySplitBalancesTheSubtrees) {
+  const SnSparse A = testing::MakeRandomTetBlockSpd(14, 10, 8, 21);
+  SparseLdlt ldlt;
+  ldlt.Analyze(A, SparseLdlt::Kernel::kSupernodal);
+  const SupernodalCholesky& factor = ldlt.supernodal_factor();
+  ASSERT_TRUE(factor.has_two_way_split());
+  const std::array<double, 3>& work = factor.split_work();
+  const double total = work[0] + work[1] + work[2];
+  std::printf("split work: %.3g + %.3g on two threads, %.3g above (of %.3g)\n", work[0], work[1],
+              work[2], total);
+  EXPECT_GE(std::min(work[0], work[1]), SupernodalCholesky::kMinGroupShare * total);
+  SparseLdlt small;
+  small.Analyze(testing::MakeRandomTetBlockSpd(3, 2, 2, 4), SparseLdlt::Kernel::kSupernodal);
+  EXPECT_FALSE(small.supernodal_factor().has_two_way_split());
 }
 
 }  // namespace
