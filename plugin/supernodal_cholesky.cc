@@ -202,8 +202,9 @@ void SupernodalCholesky::FindTwoWaySplit() {
   double total = 0.0;
   for (int s = 0; s < num_sn; ++s) {
     const double w = width(s), b = rows_in(s) - width(s);
-    subtree_work[s] += w * w * w / 3.0 + w * w * b + 0.5 * w * b * b;
-    total += w * w * w / 3.0 + w * w * b + 0.5 * w * b * b;
+    const double own = w * w * w / 3.0 + w * w * b + 0.5 * w * b * b;
+    subtree_work[s] += own;
+    total += own;
     if (rows_in(s) > width(s)) {
       const int p = sn_of_[rows_[row_start_[s] + width(s)]];
       subtree_work[p] += subtree_work[s];  // p > s: children come first
@@ -305,10 +306,7 @@ bool SupernodalCholesky::FactorSupernode(int t, Workspace& ws, Link& link, Faile
 }
 
 bool SupernodalCholesky::FactorSerially(Workspace& ws, FailedPivot& failed) {
-  auto link = [this](int d, int p) {
-    next_[d] = head_[p];
-    head_[p] = d;
-  };
+  auto link = [this](int d, int p) { LinkWaiting(d, p); };
   for (int t = 0; t < num_supernodes(); ++t)
     if (!FactorSupernode(t, ws, link, failed)) return false;
   return true;
@@ -328,8 +326,7 @@ bool SupernodalCholesky::FactorOnTwoThreads(ElementLoopRunner& runner, FailedPiv
     for (const int t : group_nodes_[g]) {
       auto link = [&](int d, int p) {
         if (group_of_[p] == g) {
-          next_[d] = head_[p];
-          head_[p] = d;
+          LinkWaiting(d, p);
         } else {
           deferred_[g].push_back({t, d, p});
         }
@@ -350,14 +347,10 @@ bool SupernodalCholesky::FactorOnTwoThreads(ElementLoopRunner& runner, FailedPiv
     while ((i < a.size() && a[i].t < u) || (j < b.size() && b[j].t < u)) {
       const DeferredLink& next =
           j == b.size() || (i < a.size() && a[i].t < b[j].t) ? a[i++] : b[j++];
-      next_[next.d] = head_[next.p];
-      head_[next.p] = next.d;
+      LinkWaiting(next.d, next.p);
     }
   };
-  auto link = [this](int d, int p) {
-    next_[d] = head_[p];
-    head_[p] = d;
-  };
+  auto link = [this](int d, int p) { LinkWaiting(d, p); };
   // After a failure in a group the serial loop would still have factored (and may have failed at)
   // the supernodes above the groups that come before it; none after it.
   const int group_failure = std::min(failed_at[0], failed_at[1]);

@@ -118,6 +118,11 @@ class SupernodalCholesky {
   struct DeferredLink {
     int t, d, p;
   };
+  // Puts descendant d first on supernode p's list of waiting descendants.
+  void LinkWaiting(int d, int p) {
+    next_[d] = head_[p];
+    head_[p] = d;
+  }
   // Steps 2 and 3 for supernode t; link(d, p) puts d on p's list of waiting descendants.
   template <typename Link>
   bool FactorSupernode(int t, Workspace& ws, Link& link, FailedPivot& failed);
