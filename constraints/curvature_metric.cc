@@ -1,5 +1,7 @@
 #include "constraints/curvature_metric.h"
 
+#include <Eigen/Eigenvalues>
+
 namespace taut {
 
 void CurvatureMetric::CollectLimitRows(double h, const std::vector<IslandBody*>& bodies,
@@ -61,6 +63,26 @@ void CurvatureMetric::AddTimes(const std::vector<VecX>& u, std::vector<VecX>& ou
     for (int n = 0; n < e.num_nodes; ++n)
       out[e.body].segment<3>(3 * e.nodes[n]) += ge.segment<3>(3 * n);
   }
+}
+
+int CurvatureMetric::ClampIndefiniteElementBlocks() {
+  // A Cholesky factor of B + delta I (delta = 1e-10 max |B_kk|) proves lambda_min(B) > -delta
+  // and B stays; the others are replaced by their positive semi-definite part (negative
+  // eigenvalues set to 0), which then pass the same test.
+  int clamped = 0;
+  for (const ElementBlock& e : elements_) {
+    Eigen::Map<MatX> block(values_.data() + e.offset, 3 * e.num_nodes, 3 * e.num_nodes);
+    const double delta = 1e-10 * block.diagonal().cwiseAbs().maxCoeff();
+    MatX shifted = block;
+    shifted.diagonal().array() += delta;
+    if (block.isZero(0.0) || (delta > 0.0 && Eigen::LLT<MatX>(shifted).info() == Eigen::Success))
+      continue;
+    const Eigen::SelfAdjointEigenSolver<MatX> eigen(block);
+    block = eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).asDiagonal() *
+            eigen.eigenvectors().transpose();
+    ++clamped;
+  }
+  return clamped;
 }
 
 void CurvatureMetric::AddToNewtonMatrices(const std::vector<IslandBody*>& bodies) const {

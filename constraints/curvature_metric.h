@@ -23,6 +23,9 @@ class CurvatureMetric final : public CurvatureSink {
                         const std::vector<ConstraintSource*>& sources, const IslandRows& rows,
                         const VecX& lambda, const std::vector<VecX>& v);
   void Clear();
+  // Replaces each element block that is not positive definite by its positive semi-definite part
+  // (the sources may keep mildly negative modes, strain_frame_curvature.h); returns how many.
+  int ClampIndefiniteElementBlocks();
   bool empty() const { return node_blocks_.empty() && elements_.empty(); }
   // out_b += G_b u_b for every body b.
   void AddTimes(const std::vector<VecX>& u, std::vector<VecX>& out) const;

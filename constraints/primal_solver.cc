@@ -284,6 +284,13 @@ int PrimalSolver::AssembleNewtonMatrices(const std::vector<IslandBody*>& bodies)
   } catch (const SimulationError&) {
     // The curvature is only a metric: without it H = A + sum rho J^T D J is positive definite.
     if (curvature_.empty()) throw;
+    // Its element blocks may keep mildly negative modes (strain_frame_curvature.h): clamped
+    // exactly, G usually lets H factor, and the step keeps the curvature (docs/math.md §5.9).
+    if (clamp_on_failure_ && !curvature_clamped_) {
+      curvature_clamped_ = true;
+      if (curvature_.ClampIndefiniteElementBlocks() > 0)
+        return factored + AssembleNewtonMatrices(bodies);
+    }
     curvature_.Clear();
     return factored + AssembleNewtonMatrices(bodies);
   }
@@ -595,6 +602,8 @@ bool PrimalSolver::TakeNewtonStep(double h, const std::vector<IslandBody*>& bodi
   const size_t nb = bodies.size();
   CalcProjectedMultipliers();
   CalcGradient(bodies);
+  curvature_clamped_ = false;
+  clamp_on_failure_ = primal.clamp_curvature_on_failure;
   if (primal.curvature)
     CollectCurvature(h, bodies, sources);
   else
@@ -608,6 +617,7 @@ bool PrimalSolver::TakeNewtonStep(double h, const std::vector<IslandBody*>& bodi
   const double decrement = -Dot(grad_, d_);
   const double scale = Dot(w_, aw_);
   if (!(decrement > primal.newton_tolerance * std::max(scale, 1e-300))) return false;
+  last_decrement_ = decrement / std::max(scale, 1e-300);
   double alpha = SearchModelLine(bodies, Dot(d_, aw_));
   if (alpha <= 0.0) return false;
   // Armijo backtracking on the nonlinear Phi (rows re-evaluated at each trial). With w = v - v*
@@ -625,6 +635,7 @@ bool PrimalSolver::TakeNewtonStep(double h, const std::vector<IslandBody*>& bodi
       })) {
     model_d0_ = d_;
     const double line_a0 = line_a0_, line_dAd = line_dAd_;
+    last_alpha_ = 0.0;  // a model step: the rows cut the first step short
     if (TryModelSteps(h, alpha, phi0, bodies, sources, settings, stats)) return true;
     d_ = model_d0_;  // the plain step along the first direction
     line_a0_ = line_a0;
@@ -635,6 +646,7 @@ bool PrimalSolver::TakeNewtonStep(double h, const std::vector<IslandBody*>& bodi
     CollectRowsAt(h, bodies, sources, v_trial_, settings, stats);
     const double energy = 0.5 * scale + alpha * line_a0_ + 0.5 * alpha * alpha * line_dAd_;
     if (energy + CalcRowMerit(v_trial_) <= phi0 - 1e-4 * alpha * decrement) {
+      last_alpha_ = alpha;
       return true;
     }
     if (halving >= settings.max_line_search_halvings) break;
@@ -665,6 +677,20 @@ bool PrimalSolver::IsNewtonIterateCertified(const std::vector<IslandBody*>& bodi
   const double distance_tolerance =
       settings.primal.newton_stop_distance_factor * settings.violation_tolerance;
   return kkt.max_distance_residual() <= distance_tolerance;
+}
+
+bool PrimalSolver::IsViolationStalled(double violation_before, double tolerance,
+                                      const PrimalSettings& settings) const {
+  // Phi's minimizer for this lambda_bar and rho is violated: once a Newton step near that
+  // minimizer (relative decrement below newton_stall_decrement, alpha >= 1/2: the rows did not
+  // cut it short) closes less than newton_stall_fraction of the gap to the tolerance, the remaining
+  // steps converge v to that violated minimizer and only the multiplier update moves the rows on
+  // (docs/math.md §5.8, inexact inner solves).
+  if (settings.newton_stall_fraction <= 0.0 || violation_ <= tolerance) return false;
+  if (last_alpha_ < 0.5 || last_decrement_ > settings.newton_stall_decrement) return false;
+  const double gap = violation_before - tolerance;
+  return gap > 0.0 &&
+         std::abs(violation_before - violation_) < settings.newton_stall_fraction * gap;
 }
 
 bool PrimalSolver::WarmStartVelocities(const std::vector<IslandBody*>& bodies) {
@@ -799,10 +825,14 @@ void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     if (primal.penalty_growth > 1.0) GrowStalledPenalties(primal, settings.violation_tolerance);
     KeepPenalties();
     for (int it = 0; it < primal.max_newton_iterations; ++it) {
+      const double violation_before = violation_;
       if (!TakeNewtonStep(h, bodies, sources, settings, stats)) break;
       newton_certified_ =
           primal.stop_newton_on_certificate && IsNewtonIterateCertified(bodies, h, settings);
       if (newton_certified_) break;
+      if (k < primal.newton_stall_iterations &&
+          IsViolationStalled(violation_before, settings.violation_tolerance, primal))
+        break;
     }
     if (!newton_certified_) CalcProjectedMultipliers();  // else lambda_ is Proj(y(v)) already
     lambda_bar_ = lambda_;

@@ -72,6 +72,10 @@ class PrimalSolver {
                              const SqpSettings& settings, StepStats& stats);
   // v = v* + A^-1 J^T lambda_bar into v_trial_ (false when there is no warm multiplier).
   bool WarmStartVelocities(const std::vector<IslandBody*>& bodies);
+  // Whether the last Newton step, taken from a violation of violation_before, shows the inner
+  // minimizer violated (PrimalSettings::newton_stall_fraction): the Newton loop ends.
+  bool IsViolationStalled(double violation_before, double tolerance,
+                          const PrimalSettings& settings) const;
   // rho_c of every row from the diagonal Delassus estimate (friction rows: their normal's), with
   // a pushing limit row's own curvature in its effective mass.
   void CalcPenalties(double h, const std::vector<IslandBody*>& bodies,
@@ -164,6 +168,8 @@ class PrimalSolver {
   double stale_budget_ = 0.0;      // CG iterations a kept factor may take before a refactor
   bool refactor_next_ = false;     // the last kept factor took too many: refactor
   double violation_ = 0.0;         // largest row violation at the collected rows
+  double last_alpha_ = 0.0;        // step length of the last accepted plain Newton step
+  double last_decrement_ = 0.0;    // its Newton decrement over ||v - v*||_A^2
   bool newton_certified_ = false;  // the Newton loop stopped on the certificate ...
   KktResiduals newton_kkt_;        // ... with these residuals at (v, Proj(y(v)))
   // Model steps: the linearization point v_lin, G (v - v_lin), and the plain step kept aside.
@@ -171,6 +177,8 @@ class PrimalSolver {
   bool model_steps_off_ = false;  // a model step fell short of its model in this step (solve)
   double line_a0_ = 0.0, line_dAd_ = 0.0;  // d^T A (v - v*) and d^T A d of the model line search
   CurvatureMetric curvature_;
+  bool clamp_on_failure_ = true;    // PrimalSettings::clamp_curvature_on_failure of this solve
+  bool curvature_clamped_ = false;  // this Newton iteration's G had its element blocks clamped
   // Consecutive rows on the same nodes of one body (one element's rows): their summed
   // rho D J^T J as one dense block, scattered into the Newton matrix once.
   struct RowGroup {

@@ -33,9 +33,20 @@ struct PrimalSettings {
   // distance rows (contacts, joints) held to newton_stop_distance_factor of their tolerance.
   bool stop_newton_on_certificate = true;
   double newton_stop_distance_factor = 0.1;
+  // ... or once a plain Newton step near Phi's minimizer (alpha >= 1/2, relative decrement below
+  // newton_stall_decrement) closes less than newton_stall_fraction of the gap between the rows'
+  // violation and its tolerance: Phi's minimizer is violated, and the multiplier update, not more
+  // Newton steps, moves the rows on (newton_stall_fraction 0 = off; docs/math.md §5.8). Only in
+  // the first newton_stall_iterations multiplier iterations: later ones solve Phi fully.
+  double newton_stall_fraction = 0.05;
+  double newton_stall_decrement = 1e-2;
+  int newton_stall_iterations = 4;
   int max_pcg_iterations = 200;  // coupled islands: PCG on the Newton step
   double pcg_tolerance = 1e-10;  // relative residual of that PCG
   bool curvature = true;         // lagged row curvature G in the model and H
+  // When H with G does not factor, G's element blocks are clamped exactly to their positive
+  // semi-definite part and H factored again before G is dropped for the iteration (§5.9).
+  bool clamp_curvature_on_failure = true;
   // Model steps: when the model line search stops short of the Newton step (alpha below
   // model_step_alpha: a row turns active along d), up to max_model_steps further Newton steps on
   // the same linearization (rows, rho and G fixed), by PCG preconditioned with this iteration's

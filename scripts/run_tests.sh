@@ -136,6 +136,7 @@ asan_long_tests+='|BoxOnASoftPadFeelsItsWeightAndThePadTheOpposite|SoftBlockRest
 asan_long_tests+='|CrushedBlockKeepsEveryStretchAboveTheFloor|GripperScene|CapsuleRolledOverASoftSlab'
 asan_long_tests+='|AfterAFailedRetryTheIslandIsNotRetriedForAWhile|WarmStartVelocityKeepsThePresses'
 asan_long_tests+='|FrameCurvatureHalvesTheAnisotropicBeams|SlackPushingRowsGetLargerPenalties|ModelStepsCutTheIsotropicBeams'
+asan_long_tests+='|StalledNewtonLoopsHandOverToTheMultiplierUpdate|ClampedCurvatureKeepsTheAnisotropicBeams'
 
 # Stage 3: Debug build with AddressSanitizer + UBSan and its tests (without the long ones above).
 stage_asan() {

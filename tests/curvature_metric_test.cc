@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Eigenvalues>
 #include <random>
 
 #include "constraints/deformable_island_body.h"
@@ -152,6 +153,40 @@ TEST(CurvatureMetricTest, ProductAndNewtonPartAreTheDenseSumOfItsBlocks) {
 
   metric.Clear();
   EXPECT_TRUE(metric.empty());
+}
+
+TEST(CurvatureMetricTest, ClampingReplacesOnlyIndefiniteElementBlocksByTheirPsdPart) {
+  // A positive definite block stays bit for bit; an indefinite one becomes V max(Lambda, 0) V^T:
+  // positive semi-definite, the same on its non-negative eigenvectors, zero on the negative ones.
+  std::mt19937 rng(5);
+  const MatX random = RandomSymmetricBlock(4, rng);
+  const MatX definite = random * random.transpose() + MatX::Identity(12, 12);
+  MatX indefinite = RandomSymmetricBlock(4, rng);
+  const Eigen::SelfAdjointEigenSolver<MatX> before(indefinite);
+  ASSERT_LT(before.eigenvalues().minCoeff(), -0.1);
+  ASSERT_GT(before.eigenvalues().maxCoeff(), 0.1);
+  const int nodes[4] = {0, 1, 2, 3};
+  CurvatureMetric metric;
+  metric.AddElementBlock(0, 0, nodes, definite);
+  metric.AddElementBlock(0, 1, nodes, indefinite);
+  EXPECT_EQ(metric.ClampIndefiniteElementBlocks(), 1);
+  // Both blocks sit on the same four nodes of body 0: column j of G is G e_j = (B_0 + B_1) e_j.
+  MatX G(12, 12);
+  for (int j = 0; j < 12; ++j) {
+    std::vector<VecX> u = {VecX::Unit(12, j)}, out = {VecX::Zero(12)};
+    metric.AddTimes(u, out);
+    G.col(j) = out[0];
+  }
+  const MatX clamped = G - definite;
+  EXPECT_LT((clamped - clamped.transpose()).norm(), 1e-12 * clamped.norm());
+  const Eigen::SelfAdjointEigenSolver<MatX> after(clamped);
+  EXPECT_GT(after.eigenvalues().minCoeff(), -1e-12 * after.eigenvalues().maxCoeff());
+  for (int i = 0; i < 12; ++i) {
+    const VecX q = before.eigenvectors().col(i);
+    const double expected = std::max(0.0, before.eigenvalues()[i]);
+    EXPECT_NEAR(q.dot(clamped * q), expected, 1e-10) << "eigenvalue " << before.eigenvalues()[i];
+  }
+  EXPECT_EQ(metric.ClampIndefiniteElementBlocks(), 0);  // nothing left to clamp
 }
 
 }  // namespace
