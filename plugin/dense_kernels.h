@@ -2,7 +2,8 @@
 // twice and chosen once per process by the CPU: a generic x86-64 (SSE2) build, and on x86-64 an
 // AVX2 + FMA build of the same source (plugin/dense_kernels_body.inc). Debian packages are built
 // for the generic ISA; these kernels are where the wider vectors pay (factor + solve of the
-// 368-hex armadillo 2.3 -> 1.4 ms, of a 100k-tet beam 2.4 -> 1.2 s, AMD EPYC; README).
+// 368-hex armadillo 2.3 -> 1.4 ms, of a 100k-tet beam 2.4 -> 1.2 s, AMD EPYC; README), and the
+// single-precision panel solves of a kept factor's CG (bench/tet_scaling_bench.cc).
 //
 // All matrices are column-major with a leading dimension (ld >= rows); blocks of right-hand sides
 // of the supernodal solves are row-major with `cols` entries per row. The two builds round
@@ -42,6 +43,11 @@ struct DenseKernels {
                                         int m, int k, double* out, int ldo);
   // out (m x m) = a^T a, both triangles, by rank updates of kDenseProductDepthChunk rows.
   void (*gram_by_chunks)(const double* a, int lda, int d, int m, double* out, int ldo);
+  // The single-precision solve of a kept factor (supernodal_cholesky.h), one panel (m rows, w
+  // columns, column-major fl32 L) on a dense u (m) in double: forward u_t = L_tt^-1 u_t,
+  // u_rest -= L_rest u_t; backward u_t = L_tt^-T (u_t - L_rest^T u_rest).
+  void (*forward_panel_single)(const float* l, int m, int w, double* u);
+  void (*backward_panel_single)(const float* l, int m, int w, double* u);
 };
 
 // Eigen splits a product's depth into blocks sized from the CPU's L1 cache and sums the partial

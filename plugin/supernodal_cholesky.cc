@@ -452,80 +452,11 @@ void SupernodalCholesky::MakeSinglePrecisionCopy() {
   single_current_ = true;
 }
 
-namespace {
-constexpr int kSingleBlock = 4;  // panel columns per pass of the single-precision kernels
-
-// Forward solve of one panel (m rows, w columns, column-major fl32 L) on u (m): the leading w x w
-// lower triangle L_tt u_t = u_t, then u_rest -= L_rest u_t, kSingleBlock columns per pass over
-// the rows below them.
-void SolvePanelForward(const float* l, int m, int w, double* u) {
-  int j = 0;
-  for (; j + kSingleBlock <= w; j += kSingleBlock) {
-    const float* c0 = l + static_cast<size_t>(j) * m;
-    const float* c1 = c0 + m;
-    const float* c2 = c1 + m;
-    const float* c3 = c2 + m;
-    const double u0 = u[j] / c0[j];
-    const double u1 = (u[j + 1] - c0[j + 1] * u0) / c1[j + 1];
-    const double u2 = (u[j + 2] - c0[j + 2] * u0 - c1[j + 2] * u1) / c2[j + 2];
-    const double u3 = (u[j + 3] - c0[j + 3] * u0 - c1[j + 3] * u1 - c2[j + 3] * u2) / c3[j + 3];
-    u[j] = u0;
-    u[j + 1] = u1;
-    u[j + 2] = u2;
-    u[j + 3] = u3;
-    for (int i = j + kSingleBlock; i < m; ++i)
-      u[i] -= static_cast<double>(c0[i]) * u0 + static_cast<double>(c1[i]) * u1 +
-              static_cast<double>(c2[i]) * u2 + static_cast<double>(c3[i]) * u3;
-  }
-  for (; j < w; ++j) {
-    const float* c = l + static_cast<size_t>(j) * m;
-    const double u_j = u[j] / c[j];
-    u[j] = u_j;
-    for (int i = j + 1; i < m; ++i) u[i] -= static_cast<double>(c[i]) * u_j;
-  }
-}
-
-// Backward solve of one panel: u_t = L_tt^-T (u_t - L_rest^T u_rest), columns from the last,
-// kSingleBlock per pass (their dot products with the rows below the block in one sweep).
-void SolvePanelBackward(const float* l, int m, int w, double* u) {
-  int j = w;
-  for (; j - kSingleBlock >= 0; j -= kSingleBlock) {
-    const int j0 = j - kSingleBlock;
-    const float* c0 = l + static_cast<size_t>(j0) * m;
-    const float* c1 = c0 + m;
-    const float* c2 = c1 + m;
-    const float* c3 = c2 + m;
-    double d0 = 0.0, d1 = 0.0, d2 = 0.0, d3 = 0.0;
-#pragma omp simd reduction(+ : d0, d1, d2, d3)
-    for (int i = j; i < m; ++i) {
-      d0 += static_cast<double>(c0[i]) * u[i];
-      d1 += static_cast<double>(c1[i]) * u[i];
-      d2 += static_cast<double>(c2[i]) * u[i];
-      d3 += static_cast<double>(c3[i]) * u[i];
-    }
-    const double u3 = (u[j0 + 3] - d3) / c3[j0 + 3];
-    const double u2 = (u[j0 + 2] - d2 - c2[j0 + 3] * u3) / c2[j0 + 2];
-    const double u1 = (u[j0 + 1] - d1 - c1[j0 + 2] * u2 - c1[j0 + 3] * u3) / c1[j0 + 1];
-    const double u0 = (u[j0] - d0 - c0[j0 + 1] * u1 - c0[j0 + 2] * u2 - c0[j0 + 3] * u3) / c0[j0];
-    u[j0] = u0;
-    u[j0 + 1] = u1;
-    u[j0 + 2] = u2;
-    u[j0 + 3] = u3;
-  }
-  for (--j; j >= 0; --j) {
-    const float* c = l + static_cast<size_t>(j) * m;
-    double d = 0.0;
-#pragma omp simd reduction(+ : d)
-    for (int i = j + 1; i < m; ++i) d += static_cast<double>(c[i]) * u[i];
-    u[j] = (u[j] - d) / c[j];
-  }
-}
-}  // namespace
-
 // (L_f L_f^T)^-1 y by panels: each gathers its rows of y into a dense u, solves there
-// (SolvePanelForward / SolvePanelBackward) and scatters back.
+// (DenseKernels::forward_panel_single / backward_panel_single) and scatters back.
 void SupernodalCholesky::SolveSinglePrecision(double* y) const {
   TAUT_ASSERT(single_current_);
+  const DenseKernels& kernels = ActiveDenseKernels();
   double* u = solve_work_.data();
   const int num_sn = num_supernodes();
   for (int s = 0; s < num_sn; ++s) {
@@ -535,7 +466,7 @@ void SupernodalCholesky::SolveSinglePrecision(double* y) const {
     for (int k = 0; k < w; ++k) zero = zero && y[rows_s[k]] == 0.0;
     if (zero) continue;  // zero rows stay zero
     for (int k = 0; k < m; ++k) u[k] = k < w ? y[rows_s[k]] : 0.0;
-    SolvePanelForward(values_single_.data() + val_start_[s], m, w, u);
+    kernels.forward_panel_single(values_single_.data() + val_start_[s], m, w, u);
     for (int k = 0; k < w; ++k) y[rows_s[k]] = u[k];
     for (int k = w; k < m; ++k) y[rows_s[k]] += u[k];
   }
@@ -543,7 +474,7 @@ void SupernodalCholesky::SolveSinglePrecision(double* y) const {
     const int w = width(s), m = rows_in(s);
     const int* rows_s = rows_.data() + row_start_[s];
     for (int k = 0; k < m; ++k) u[k] = y[rows_s[k]];
-    SolvePanelBackward(values_single_.data() + val_start_[s], m, w, u);
+    kernels.backward_panel_single(values_single_.data() + val_start_[s], m, w, u);
     for (int k = 0; k < w; ++k) y[rows_s[k]] = u[k];
   }
 }

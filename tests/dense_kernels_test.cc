@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <cstdlib>
 #include <string>
@@ -116,6 +117,43 @@ TEST(DenseKernelsTest, CholeskyAndTriangularSolvesInvertThePanelInEverySet) {
       expected = l.transpose().triangularView<Eigen::Upper>().solve(expected);
       kernels->backward_supernode(panel.data(), ld, w, below, y.data(), cols, t.data());
       EXPECT_LT((Eigen::MatrixXd(y) - expected).norm(), 1e-10 * expected.norm());
+    }
+  }
+}
+
+TEST(DenseKernelsTest, SinglePrecisionPanelSolvesInvertTheFloatPanelInEverySet) {
+  // The kept factor's panels in fl32 (m rows, w columns, column-major, no padding), u in double:
+  // forward u_t = L_tt^-1 u_t, u_rest -= L_rest u_t; backward u_t = L_tt^-T (u_t - L_rest^T
+  // u_rest), against the same solves in double on the float entries. w = 7 covers the blocked
+  // passes of 4 columns and the single columns after them.
+  for (const DenseKernels* kernels : KernelSetsOfThisMachine()) {
+    SCOPED_TRACE(kernels->name);
+    for (const int w : {7, 8}) {
+      SCOPED_TRACE(w);
+      const int below = 29, m = w + below;
+      const Eigen::MatrixXd spd = RandomSpd(w, 11);
+      std::srand(12);
+      Eigen::MatrixXd panel(m, w);
+      panel << Eigen::MatrixXd(spd.llt().matrixL()), Eigen::MatrixXd::Random(below, w);
+      const Eigen::MatrixXf single = panel.cast<float>();
+      const Eigen::MatrixXd l = single.cast<double>();  // what the kernels multiply by
+      const Eigen::MatrixXd l_tt = l.topRows(w).triangularView<Eigen::Lower>();
+      std::srand(13);
+      const Eigen::VectorXd u0 = Eigen::VectorXd::Random(m);
+
+      Eigen::VectorXd u = u0;
+      kernels->forward_panel_single(single.data(), m, w, u.data());
+      const Eigen::VectorXd top = l_tt.triangularView<Eigen::Lower>().solve(u0.head(w));
+      EXPECT_LT((u.head(w) - top).norm(), 1e-12 * top.norm());
+      const Eigen::VectorXd rest = u0.tail(below) - l.bottomRows(below) * top;
+      EXPECT_LT((u.tail(below) - rest).norm(), 1e-12 * rest.norm());
+
+      u = u0;
+      kernels->backward_panel_single(single.data(), m, w, u.data());
+      const Eigen::VectorXd rhs = u0.head(w) - l.bottomRows(below).transpose() * u0.tail(below);
+      const Eigen::VectorXd expected = l_tt.transpose().triangularView<Eigen::Upper>().solve(rhs);
+      EXPECT_LT((u.head(w) - expected).norm(), 1e-12 * expected.norm());
+      EXPECT_EQ(u.tail(below), u0.tail(below)) << "the rows below are read, not written";
     }
   }
 }
