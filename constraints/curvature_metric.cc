@@ -69,15 +69,18 @@ int CurvatureMetric::ClampIndefiniteElementBlocks() {
   // A Cholesky factor of B + delta I (delta = 1e-10 max |B_kk|) proves lambda_min(B) > -delta
   // and B stays; the others are replaced by their positive semi-definite part (negative
   // eigenvalues set to 0), which then pass the same test.
+  // Element blocks are at most 3 kMaxRowNodes square: no heap allocation per block.
+  using Block =
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 3 * kMaxRowNodes, 3 * kMaxRowNodes>;
   int clamped = 0;
   for (const ElementBlock& e : elements_) {
     Eigen::Map<MatX> block(values_.data() + e.offset, 3 * e.num_nodes, 3 * e.num_nodes);
     const double delta = 1e-10 * block.diagonal().cwiseAbs().maxCoeff();
-    MatX shifted = block;
+    Block shifted = block;
     shifted.diagonal().array() += delta;
-    if (block.isZero(0.0) || (delta > 0.0 && Eigen::LLT<MatX>(shifted).info() == Eigen::Success))
+    if (block.isZero(0.0) || (delta > 0.0 && Eigen::LLT<Block>(shifted).info() == Eigen::Success))
       continue;
-    const Eigen::SelfAdjointEigenSolver<MatX> eigen(block);
+    const Eigen::SelfAdjointEigenSolver<Block> eigen{Block(block)};
     block = eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).asDiagonal() *
             eigen.eigenvectors().transpose();
     ++clamped;

@@ -243,7 +243,8 @@ void PrimalSolver::ChooseFactorReuse(const std::vector<IslandBody*>& bodies,
   refactor_next_ = false;
 }
 
-int PrimalSolver::AssembleNewtonMatrices(const std::vector<IslandBody*>& bodies) {
+int PrimalSolver::AssembleNewtonMatrices(const std::vector<IslandBody*>& bodies,
+                                         bool clamp_on_failure) {
   // Bodies that keep their factor need no new H: their step is CG on the exact operator.
   if (std::all_of(stale_.begin(), stale_.end(), [](char s) { return s != 0; })) return 0;
   for (IslandBody* body : bodies) body->ResetNewtonMatrix();
@@ -286,13 +287,8 @@ int PrimalSolver::AssembleNewtonMatrices(const std::vector<IslandBody*>& bodies)
     if (curvature_.empty()) throw;
     // Its element blocks may keep mildly negative modes (strain_frame_curvature.h): clamped
     // exactly, G usually lets H factor, and the step keeps the curvature (docs/math.md §5.9).
-    if (clamp_on_failure_ && !curvature_clamped_) {
-      curvature_clamped_ = true;
-      if (curvature_.ClampIndefiniteElementBlocks() > 0)
-        return factored + AssembleNewtonMatrices(bodies);
-    }
-    curvature_.Clear();
-    return factored + AssembleNewtonMatrices(bodies);
+    if (!clamp_on_failure || curvature_.ClampIndefiniteElementBlocks() == 0) curvature_.Clear();
+    return factored + AssembleNewtonMatrices(bodies, false);
   }
   return factored;
 }
@@ -602,14 +598,12 @@ bool PrimalSolver::TakeNewtonStep(double h, const std::vector<IslandBody*>& bodi
   const size_t nb = bodies.size();
   CalcProjectedMultipliers();
   CalcGradient(bodies);
-  curvature_clamped_ = false;
-  clamp_on_failure_ = primal.clamp_curvature_on_failure;
   if (primal.curvature)
     CollectCurvature(h, bodies, sources);
   else
     curvature_.Clear();
   ChooseFactorReuse(bodies, primal);
-  stats.newton_factorizations += AssembleNewtonMatrices(bodies);
+  stats.newton_factorizations += AssembleNewtonMatrices(bodies, primal.clamp_curvature_on_failure);
   stats.pcg_iterations += SolveNewtonStep(bodies, primal);
   stats.newton_iterations++;
 

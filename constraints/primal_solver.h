@@ -126,7 +126,9 @@ class PrimalSolver {
   void ChooseFactorReuse(const std::vector<IslandBody*>& bodies, const PrimalSettings& settings);
   // N_b = A_b + G_b + sum rho D J^T J (same-body blocks of rows held on the pattern), factored
   // for the bodies that do not keep their factor. Returns the number of factorizations.
-  int AssembleNewtonMatrices(const std::vector<IslandBody*>& bodies);
+  // When that factorization fails with G, G's indefinite element blocks are clamped first if
+  // clamp_on_failure (PrimalSettings::clamp_curvature_on_failure), else G is dropped; then again.
+  int AssembleNewtonMatrices(const std::vector<IslandBody*>& bodies, bool clamp_on_failure);
   // d = -H^-1 grad: one solve per body when H = N, else PCG with N as preconditioner. Returns the
   // PCG iterations (1 for the direct solve).
   int SolveNewtonStep(const std::vector<IslandBody*>& bodies, const PrimalSettings& settings);
@@ -177,8 +179,6 @@ class PrimalSolver {
   bool model_steps_off_ = false;  // a model step fell short of its model in this step (solve)
   double line_a0_ = 0.0, line_dAd_ = 0.0;  // d^T A (v - v*) and d^T A d of the model line search
   CurvatureMetric curvature_;
-  bool clamp_on_failure_ = true;    // PrimalSettings::clamp_curvature_on_failure of this solve
-  bool curvature_clamped_ = false;  // this Newton iteration's G had its element blocks clamped
   // Consecutive rows on the same nodes of one body (one element's rows): their summed
   // rho D J^T J as one dense block, scattered into the Newton matrix once.
   struct RowGroup {

@@ -276,21 +276,21 @@ TEST(PrimalSolverTest, FrameCurvatureHalvesTheAnisotropicBeamsNewtonIterations) 
   EXPECT_LT(newton[1], 0.75 * newton[0]);
 }
 
-// 120 primal steps of the soft isotropic beam (240 tets, ellipsoid rows of equal limits: exact
-// curvature) with its primal settings changed by `configure`: summed Newton iterations,
-// unconverged steps, the largest violation after a step and the tip displacement at the end.
-struct IsotropicBeamRun {
+// Primal steps of one beam of the tet_beam scene with its primal settings changed by `configure`:
+// summed Newton iterations, unconverged steps, the largest violation after a step and the tip
+// displacement at the end.
+struct BeamRun {
   int newton = 0, unconverged = 0;
   double worst = 0.0;
   Vec3 tip = Vec3::Zero();
 };
 template <typename Configure>
-IsotropicBeamRun RunBeamOnThePrimalPath(int beam, Configure configure, int steps = 120) {
+BeamRun RunBeamOnThePrimalPath(int beam, Configure configure, int steps = 120) {
   TetBeamScene scene({TetBeamScene::DefaultBeams()[beam]});
   SqpSettings& settings = scene.world().mutable_solver_settings();
   settings.solver = IslandSolverKind::kPrimal;
   configure(settings.primal);
-  IsotropicBeamRun run;
+  BeamRun run;
   for (int step = 0; step < steps; ++step) {
     scene.world().stepSimulation(1.0 / 240.0, 1, 1.0 / 240.0);
     const StepStats& stats = scene.world().last_step_stats();
@@ -301,13 +301,26 @@ IsotropicBeamRun RunBeamOnThePrimalPath(int beam, Configure configure, int steps
   run.tip = scene.CalcTipDisplacement(0);
   return run;
 }
+// A setting that changes only how the primal path gets there: both runs certify every step, the
+// changed one holds the tolerance, and its tip follows the baseline's path to 1 % of the tip
+// displacement. `what` names the pair in the printed Newton iterations.
+void ExpectTheSameCertifiedPath(const char* what, const BeamRun& baseline, const BeamRun& changed) {
+  const double tip_gap = (changed.tip - baseline.tip).norm();
+  std::printf("%s, Newton iterations: %d -> %d; tip gap %.3g m (tip displacement %.3g m)\n", what,
+              baseline.newton, changed.newton, tip_gap, baseline.tip.norm());
+  EXPECT_EQ(baseline.unconverged, 0) << what;
+  EXPECT_EQ(changed.unconverged, 0) << what;
+  EXPECT_LE(changed.worst, 1e-3) << what;
+  EXPECT_LT(tip_gap, 0.01 * baseline.tip.norm()) << what;
+}
+// The soft isotropic beam (ellipsoid rows of equal limits: exact curvature), 120 steps.
 template <typename Configure>
-IsotropicBeamRun RunIsotropicBeamOnThePrimalPath(Configure configure) {
+BeamRun RunIsotropicBeamOnThePrimalPath(Configure configure) {
   return RunBeamOnThePrimalPath(3, configure);
 }
 // The soft anisotropic beam (frame-dependent rows, the frame factor's curvature), 240 steps.
 template <typename Configure>
-IsotropicBeamRun RunAnisotropicBeamOnThePrimalPath(Configure configure) {
+BeamRun RunAnisotropicBeamOnThePrimalPath(Configure configure) {
   return RunBeamOnThePrimalPath(2, configure, 240);
 }
 
@@ -316,19 +329,11 @@ TEST(PrimalSolverTest, ModelStepsCutTheIsotropicBeamsNewtonIterationsAndKeepItsP
   // the same linearization replace full Newton iterations (rows, curvature and certificate
   // evaluated again); the answer is the same certified one, so the tip follows the same path.
   ASSERT_GT(PrimalSettings().max_model_steps, 0);  // on by default
-  const IsotropicBeamRun plain =
+  const BeamRun plain =
       RunIsotropicBeamOnThePrimalPath([](PrimalSettings& primal) { primal.max_model_steps = 0; });
-  const IsotropicBeamRun model = RunIsotropicBeamOnThePrimalPath([](PrimalSettings&) {});
-  const double tip_gap = (model.tip - plain.tip).norm();
-  std::printf(
-      "120 steps, Newton iterations: plain %d, with model steps %d; tip gap %.3g m (tip "
-      "displacement %.3g m)\n",
-      plain.newton, model.newton, tip_gap, plain.tip.norm());
-  EXPECT_EQ(plain.unconverged, 0);
-  EXPECT_EQ(model.unconverged, 0);
-  EXPECT_LE(model.worst, 1e-3);
+  const BeamRun model = RunIsotropicBeamOnThePrimalPath([](PrimalSettings&) {});
+  ExpectTheSameCertifiedPath("120 steps, plain -> with model steps", plain, model);
   EXPECT_LT(model.newton, 0.8 * plain.newton);
-  EXPECT_LT(tip_gap, 0.01 * plain.tip.norm());
 }
 
 TEST(PrimalSolverTest, ScreenedWarmStartKeepsTheIsotropicBeamsPath) {
@@ -336,17 +341,11 @@ TEST(PrimalSolverTest, ScreenedWarmStartKeepsTheIsotropicBeamsPath) {
   // ranks it first (PrimalSettings::screen_warm_start): a start it skips was not the best, so
   // every step stays certified with the Newton iterations and the tip path of the full set.
   ASSERT_TRUE(PrimalSettings().screen_warm_start);  // on by default
-  const IsotropicBeamRun all = RunIsotropicBeamOnThePrimalPath(
+  const BeamRun all = RunIsotropicBeamOnThePrimalPath(
       [](PrimalSettings& primal) { primal.screen_warm_start = false; });
-  const IsotropicBeamRun screened = RunIsotropicBeamOnThePrimalPath([](PrimalSettings&) {});
-  const double tip_gap = (screened.tip - all.tip).norm();
-  std::printf("120 steps, Newton iterations: all candidates %d, screened %d; tip gap %.3g m\n",
-              all.newton, screened.newton, tip_gap);
-  EXPECT_EQ(all.unconverged, 0);
-  EXPECT_EQ(screened.unconverged, 0);
-  EXPECT_LE(screened.worst, 1e-3);
+  const BeamRun screened = RunIsotropicBeamOnThePrimalPath([](PrimalSettings&) {});
+  ExpectTheSameCertifiedPath("120 steps, all candidates -> screened", all, screened);
   EXPECT_LE(screened.newton, all.newton + all.newton / 20);
-  EXPECT_LT(tip_gap, 0.01 * all.tip.norm());
 }
 
 TEST(PrimalSolverTest, StalledNewtonLoopsHandOverToTheMultiplierUpdate) {
@@ -360,18 +359,13 @@ TEST(PrimalSolverTest, StalledNewtonLoopsHandOverToTheMultiplierUpdate) {
       return anisotropic ? RunAnisotropicBeamOnThePrimalPath(configure)
                          : RunIsotropicBeamOnThePrimalPath(configure);
     };
-    const IsotropicBeamRun full =
-        run([](PrimalSettings& primal) { primal.newton_stall_fraction = 0.0; });
-    const IsotropicBeamRun stalled = run([](PrimalSettings&) {});
-    const double tip_gap = (stalled.tip - full.tip).norm();
-    std::printf("%s beam, Newton iterations: full inner solves %d, stall stop %d; tip gap %.3g m\n",
-                anisotropic ? "anisotropic (240 steps)" : "isotropic (120 steps)", full.newton,
-                stalled.newton, tip_gap);
-    EXPECT_EQ(full.unconverged, 0);
-    EXPECT_EQ(stalled.unconverged, 0);
-    EXPECT_LE(stalled.worst, 1e-3);
+    const BeamRun full = run([](PrimalSettings& primal) { primal.newton_stall_fraction = 0.0; });
+    const BeamRun stalled = run([](PrimalSettings&) {});
+    ExpectTheSameCertifiedPath(anisotropic
+                                   ? "anisotropic beam (240 steps), full inner solves -> stall stop"
+                                   : "isotropic beam (120 steps), full inner solves -> stall stop",
+                               full, stalled);
     EXPECT_LT(stalled.newton, full.newton);
-    EXPECT_LT(tip_gap, 0.01 * full.tip.norm());
   }
 }
 
@@ -381,17 +375,11 @@ TEST(PrimalSolverTest, ClampedCurvatureKeepsTheAnisotropicBeamsNewtonMatrixCurve
   // factoring again keeps the curvature in those iterations, where dropping G cost Newton
   // iterations; the answer is the same certified one.
   ASSERT_TRUE(PrimalSettings().clamp_curvature_on_failure);  // on by default
-  const IsotropicBeamRun dropped = RunAnisotropicBeamOnThePrimalPath(
+  const BeamRun dropped = RunAnisotropicBeamOnThePrimalPath(
       [](PrimalSettings& primal) { primal.clamp_curvature_on_failure = false; });
-  const IsotropicBeamRun clamped = RunAnisotropicBeamOnThePrimalPath([](PrimalSettings&) {});
-  const double tip_gap = (clamped.tip - dropped.tip).norm();
-  std::printf("240 steps, Newton iterations: G dropped %d, G clamped %d; tip gap %.3g m\n",
-              dropped.newton, clamped.newton, tip_gap);
-  EXPECT_EQ(dropped.unconverged, 0);
-  EXPECT_EQ(clamped.unconverged, 0);
-  EXPECT_LE(clamped.worst, 1e-3);
+  const BeamRun clamped = RunAnisotropicBeamOnThePrimalPath([](PrimalSettings&) {});
+  ExpectTheSameCertifiedPath("240 steps, G dropped -> G clamped", dropped, clamped);
   EXPECT_LT(clamped.newton, dropped.newton);
-  EXPECT_LT(tip_gap, 0.01 * dropped.tip.norm());
 }
 
 TEST(PrimalSolverTest, SlackPushingRowsGetLargerPenaltiesAndConverge) {
