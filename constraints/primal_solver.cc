@@ -610,7 +610,9 @@ bool PrimalSolver::TakeNewtonStep(double h, const std::vector<IslandBody*>& bodi
   // Newton decrement -grad^T d against the scale ||v - v*||_A^2 (A(v - v*) from the gradient).
   const double decrement = -Dot(grad_, d_);
   const double scale = Dot(w_, aw_);
-  if (!(decrement > primal.newton_tolerance * std::max(scale, 1e-300))) return false;
+  if (!(decrement > primal.newton_tolerance * std::max(scale, 1e-300)) &&
+      !MovesViolatedRows(h, settings))
+    return false;
   last_decrement_ = decrement / std::max(scale, 1e-300);
   double alpha = SearchModelLine(bodies, Dot(d_, aw_));
   if (alpha <= 0.0) return false;
@@ -648,6 +650,28 @@ bool PrimalSolver::TakeNewtonStep(double h, const std::vector<IslandBody*>& bodi
   }
   // No sufficient decrease (round-off at the minimum): stay at v.
   base_.Restore(*this);
+  return false;
+}
+
+bool PrimalSolver::MovesViolatedRows(double h, const SqpSettings& settings) const {
+  // A decrement below newton_tolerance of ||v - v*||_A^2 says Phi is minimized to that relative
+  // accuracy, not that the rows are: the finger's contact forces set that scale, and a limit row
+  // violated by 2e-5 (tolerance 1e-5) changes Phi by 1e-9 of it, so the loop stopped with v short
+  // of the row's answer and the multiplier iterations cycled to their cap (docs/math.md §5.8,
+  // rows still moving). The loop goes on while d moves a row violated by more than the tolerance
+  // by more than newton_row_move_fraction of it (C changes by h J_c d; distance rows in limit-row
+  // units, as violation_).
+  const double fraction = settings.primal.newton_row_move_fraction;
+  if (fraction <= 0.0 || violation_ <= settings.violation_tolerance) return false;
+  const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
+  for (int c = 0; c < rows_.size(); ++c) {
+    const ConstraintRow& row = rows_[c];
+    const double scale = IsLimitRow(row) ? 1.0 : distance_scale;
+    if (row.friction_of > 0 || row.violation() * scale <= settings.violation_tolerance) continue;
+    if (h * scale * std::abs(rows_.CalcRowVelocity(c, d_)) >
+        fraction * settings.violation_tolerance)
+      return true;
+  }
   return false;
 }
 

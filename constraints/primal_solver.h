@@ -111,6 +111,9 @@ class PrimalSolver {
   bool TakeNewtonStep(double h, const std::vector<IslandBody*>& bodies,
                       const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
                       StepStats& stats);
+  // Whether the Newton step d still moves a row violated by more than the tolerance by more than
+  // PrimalSettings::newton_row_move_fraction of it (the decrement test's exception).
+  bool MovesViolatedRows(double h, const SqpSettings& settings) const;
   // Whether (v, Proj(y(v))) at the rows collected at v passes the certificate (the inner loop's
   // early stop, PrimalSettings::stop_newton_on_certificate); leaves lambda_ = Proj(y(v)).
   bool IsNewtonIterateCertified(const std::vector<IslandBody*>& bodies, double h,

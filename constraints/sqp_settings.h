@@ -29,6 +29,10 @@ struct PrimalSettings {
   // more than the tolerance, by its complementarity residual C (docs/math.md §5.8).
   bool grow_on_slack_push = true;
   double newton_tolerance = 1e-9;  // stop when the Newton decrement < this * ||v - v*||_A^2
+  // ... unless the step moves a row violated by more than the tolerance (its C by h J_c d) by more
+  // than newton_row_move_fraction of it: with a tight tolerance a limit row's share of Phi falls
+  // below the relative decrement test (docs/math.md §5.8, rows still moving; 0 = off).
+  double newton_row_move_fraction = 0.1;
   // ... or as soon as (v, Proj(y(v))) passes the step's certificate after a Newton step, with
   // distance rows (contacts, joints) held to newton_stop_distance_factor of their tolerance.
   bool stop_newton_on_certificate = true;

@@ -107,6 +107,42 @@ TEST(FingerSceneTest, LockedAdvancesAreTakenBackSoEveryKeptStepIsCertified) {
   EXPECT_EQ(unconverged, 0);
 }
 
+// Both paths must tell a locked advance from a feasible one the same way. The primal path's
+// Newton loop used to stop on its relative decrement (1e-9 of ||v - v*||_A^2, a scale the contact
+// forces set) with a limit row still 2e-5 past the finger's 1e-5 tolerance; its multiplier
+// iterations then cycled to the cap, and the scene took the flat anisotropic press's advance back
+// as "locked" at 27 N instead of pressing on to 40 N (docs/math.md §5.8, inexact inner solves).
+TEST(FingerSceneTest, ThePrimalPathLocksTheAnisotropicFingerWhereTheDualPathDoes) {
+  const FingerSceneSettings settings;
+  const std::vector<FingerPress> presses = {{FingerPressAxis::kFlat, FingerScene::Anisotropic()},
+                                            {FingerPressAxis::kTip, FingerScene::Anisotropic()}};
+  std::vector<FingerPressResult> results[2];
+  for (IslandSolverKind solver : {IslandSolverKind::kDual, IslandSolverKind::kPrimal}) {
+    FingerScene scene(presses, settings);
+    scene.world().mutable_solver_settings().solver = solver;
+    RunPresses(scene, 1e-3);
+    for (int p = 0; p < scene.num_presses(); ++p) {
+      const FingerPressResult& result = scene.result(p);
+      std::printf("%-6s %-17s indentation %.4f mm, reaction %6.2f N, stop %s\n",
+                  GetIslandSolverName(solver), result.name.c_str(), 1e3 * result.indentation,
+                  result.reaction, result.stop_reason.c_str());
+      EXPECT_LE(result.max_violation, 2.0 * settings.solver_tolerance) << result.name;
+      results[solver == IslandSolverKind::kPrimal].push_back(result);
+    }
+  }
+  const std::vector<FingerPressResult>& dual = results[0];
+  const std::vector<FingerPressResult>& primal = results[1];
+  // Flat: compliant along the nail normal, the full force on either path; tip: locked on both.
+  EXPECT_EQ(dual[0].stop_reason, "force");
+  EXPECT_EQ(dual[1].stop_reason, "lock");
+  for (int p = 0; p < 2; ++p) {
+    EXPECT_EQ(primal[p].stop_reason, dual[p].stop_reason) << primal[p].name;
+    EXPECT_NEAR(primal[p].indentation, dual[p].indentation, 0.02 * dual[p].indentation)
+        << primal[p].name;
+    EXPECT_NEAR(primal[p].reaction, dual[p].reaction, 0.05 * dual[p].reaction) << primal[p].name;
+  }
+}
+
 // The dual path's look-ahead rows (docs/math.md §5.7, "Rows found at the QP step"): in the
 // flat anisotropic press the QP's push moves elements outside the activation margin past their
 // limits; without those rows the merit halves every full step. Same press, same answer, fewer
