@@ -74,7 +74,9 @@ TEST(FactorReuseTest, ReusingBodyFollowsTheFactoringBodyToTheCgTolerance) {
   const double sag = (factoring->x() - MakeReuseCantilever(false)->x()).cwiseAbs().maxCoeff();
   ASSERT_GT(sag, 1e-3);
   const double gap = (reusing->x() - factoring->x()).cwiseAbs().maxCoeff();
-  EXPECT_LT(gap, 1e-6 * sag) << "sag " << sag << " m";
+  // Each step's CG error is below the tolerance relative to the step: the gap stays below it
+  // relative to the sag (measured 0.2 of it at 1e-6, 0.1 at 1e-10).
+  EXPECT_LT(gap, FactorReuseSettings().pcg_tolerance * sag) << "sag " << sag << " m";
 }
 
 // Where A has not changed since the kept factor was made (a body at rest), CG's first
