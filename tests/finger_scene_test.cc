@@ -111,7 +111,7 @@ TEST(FingerSceneTest, LockedAdvancesAreTakenBackSoEveryKeptStepIsCertified) {
 // Newton loop used to stop on its relative decrement (1e-9 of ||v - v*||_A^2, a scale the contact
 // forces set) with a limit row still 2e-5 past the finger's 1e-5 tolerance; its multiplier
 // iterations then cycled to the cap, and the scene took the flat anisotropic press's advance back
-// as "locked" at 27 N instead of pressing on to 40 N (docs/math.md §5.8, inexact inner solves).
+// as "locked" at 27 N instead of pressing on to 40 N (docs/math.md §5.8, rows still moving).
 TEST(FingerSceneTest, ThePrimalPathLocksTheAnisotropicFingerWhereTheDualPathDoes) {
   const FingerSceneSettings settings;
   const std::vector<FingerPress> presses = {{FingerPressAxis::kFlat, FingerScene::Anisotropic()},
