@@ -18,7 +18,7 @@ double IslandRows::Collect(double h, const std::vector<IslandBody*>& bodies,
   for (ConstraintSource* source : sources) source->AppendIslandRows(iterate, rows_);
   double violation = 0.0;
   for (const ConstraintRow& row : rows_)
-    violation = std::max(violation, row.violation() * (IsLimitRow(row) ? 1.0 : distance_scale));
+    violation = std::max(violation, row.violation() * CalcLimitUnitScale(row, distance_scale));
   body_rows_.resize(bodies.size());
   for (auto& rows : body_rows_) rows.clear();
   for (size_t c = 0; c < rows_.size(); ++c) {

@@ -18,6 +18,11 @@ using KeyedMultipliers = std::vector<std::pair<std::uint64_t, double>>;
 
 // True for rows whose C is a fraction of a limit (strain, energy); the others are distances [m].
 inline bool IsLimitRow(const ConstraintRow& row) { return GetRowTypeInfo(row.type).is_limit; }
+// Factor from the row's C to limit-row units: 1 for limit rows, distance_scale
+// (SqpSettings::CalcDistanceScale) for distance rows.
+inline double CalcLimitUnitScale(const ConstraintRow& row, double distance_scale) {
+  return IsLimitRow(row) ? 1.0 : distance_scale;
+}
 
 class IslandRows {
  public:

@@ -82,7 +82,7 @@ KktResiduals CalcKktResiduals(const std::vector<IslandBody*>& bodies, const Isla
   for (int c = 0; c < rows.size(); ++c) {
     const ConstraintRow& row = rows[c];
     const int type = static_cast<int>(row.type);
-    const double scale = IsLimitRow(row) ? 1.0 : distance_scale;
+    const double scale = CalcLimitUnitScale(row, distance_scale);
     kkt.primal[type] = std::max(kkt.primal[type], row.violation() * scale);
     if (row.friction_of > 0) {
       // Disk |lambda_t| <= mu lambda_n (checked once per pair, on its first row).

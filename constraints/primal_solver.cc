@@ -517,7 +517,7 @@ void PrimalSolver::CollectRowsAt(double h, const std::vector<IslandBody*>& bodie
                                  const std::vector<VecX>& v, const SqpSettings& settings,
                                  StepStats& stats) {
   const auto t = std::chrono::steady_clock::now();
-  const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
+  const double distance_scale = settings.CalcDistanceScale();
   violation_ = rows_.Collect(h, bodies, sources, v, distance_scale);
   rows_.WarmStart(iterate_, lambda_bar_);
   CalcPenalties(h, bodies, settings.primal);
@@ -663,10 +663,10 @@ bool PrimalSolver::MovesViolatedRows(double h, const SqpSettings& settings) cons
   // units, as violation_).
   const double fraction = settings.primal.newton_row_move_fraction;
   if (fraction <= 0.0 || violation_ <= settings.violation_tolerance) return false;
-  const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
+  const double distance_scale = settings.CalcDistanceScale();
   for (int c = 0; c < rows_.size(); ++c) {
     const ConstraintRow& row = rows_[c];
-    const double scale = IsLimitRow(row) ? 1.0 : distance_scale;
+    const double scale = CalcLimitUnitScale(row, distance_scale);
     if (row.friction_of > 0 || row.violation() * scale <= settings.violation_tolerance) continue;
     if (h * scale * std::abs(rows_.CalcRowVelocity(c, d_)) >
         fraction * settings.violation_tolerance)
@@ -685,7 +685,7 @@ bool PrimalSolver::IsNewtonIterateCertified(const std::vector<IslandBody*>& bodi
   // stopped at the tolerance crept 15 mm in 2 s where the exact solve holds it.
   if (violation_ > settings.violation_tolerance) return false;  // its primal residual
   CalcProjectedMultipliers();
-  const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
+  const double distance_scale = settings.CalcDistanceScale();
   newton_kkt_ = CalcKktResidualsWithRefit(
       bodies, rows_, lambda_, v_, h, distance_scale, settings.violation_tolerance,
       settings.stationarity_tolerance, scratch_, newton_reported_);
@@ -810,7 +810,7 @@ void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
   // the budget (refactor_next_ carried over): measured on rest_box (a rigid box on a soft block,
   // a coupled island), a kept factor from the settling phase took 170 PCG iterations per step
   // against 18 with a fresh one, step after step.
-  const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
+  const double distance_scale = settings.CalcDistanceScale();
   CollectRowsAt(h, bodies, sources, start, settings, stats);
   stats.violation_before = violation_;
   ChooseStartVelocities(h, bodies, sources, settings, stats);

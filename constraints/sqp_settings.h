@@ -87,8 +87,10 @@ struct SqpSettings {
   double contact_tolerance = 1e-5;    // [m] the same for contact and joint rows, whose C is a
                                       // distance (rigid contacts: h times a velocity error)
   double stationarity_tolerance = 1e-2;  // ... and the relative stationarity (kkt_certificate.h)
-  int max_restoration_iterations = 10;   // push-only iterations after the cap while infeasible
-  int max_line_search_halvings = 8;      // merit backtracking: alpha = 1, 1/2, ...
+  // Factor from a distance row's C [m] to limit-row units, so one tolerance applies to every row.
+  double CalcDistanceScale() const { return violation_tolerance / contact_tolerance; }
+  int max_restoration_iterations = 10;  // push-only iterations after the cap while infeasible
+  int max_line_search_halvings = 8;     // merit backtracking: alpha = 1, 1/2, ...
   // Dual path (docs/math.md §5.7, certificate steps): a full QP step that the merit rejects is
   // still taken when it lowers the certificate's residual (CalcCertificateResidual at its own
   // rows) by 10 % and leaves no row violated by more than full_step_violation_factor x the

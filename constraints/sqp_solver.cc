@@ -82,7 +82,7 @@ double SqpSolver::CalcMerit(double h, const std::vector<IslandBody*>& bodies,
 KktResiduals SqpSolver::CalcFullStepCertificate(double h, const std::vector<IslandBody*>& bodies,
                                                 const std::vector<ConstraintSource*>& sources,
                                                 const SqpSettings& settings, StepStats& stats) {
-  const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
+  const double distance_scale = settings.CalcDistanceScale();
   if (!full_rows_at_v_qp_) {  // else the look-ahead pass collected them at this v_QP
     const auto t_rows = std::chrono::steady_clock::now();
     full_violation_ = full_rows_.Collect(h, bodies, sources, v_qp_, distance_scale);
@@ -152,7 +152,7 @@ void SqpSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
 void SqpSolver::Iterate(double h, const std::vector<IslandBody*>& bodies,
                         const std::vector<ConstraintSource*>& sources, const SqpSettings& settings,
                         StepStats& stats) {
-  const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
+  const double distance_scale = settings.CalcDistanceScale();
   stats.sqp_iterations = 0;
   double rho = 0.0, last_alpha = 1.0;
   bool restoring = false;
@@ -258,7 +258,7 @@ bool SqpSolver::StartFromWarmMultipliers(double h, const std::vector<IslandBody*
   const size_t nb = bodies.size();
   for (size_t b = 0; b < nb; ++b) v_trial_[b].setZero(v_k_[b].size());
   const auto t_rows = std::chrono::steady_clock::now();
-  const double distance_scale = settings.violation_tolerance / settings.contact_tolerance;
+  const double distance_scale = settings.CalcDistanceScale();
   full_rows_.Collect(h, bodies, sources, v_trial_, distance_scale);  // at x0 (v = 0)
   stats.ms_rows += MsSince(t_rows);
   full_rows_.WarmStart(previous_, full_lambda_);
