@@ -37,6 +37,19 @@ std::string ChooseDenseKernels(const std::string& requested, bool avx2_available
   return requested;
 }
 
+void SetEigenCacheSizes(const EigenCacheSizes& sizes) {
+  GenericDenseKernels().set_cache_sizes(sizes.l1, sizes.l2, sizes.l3);
+  // The AVX2 set's code runs only on a CPU with AVX2 (its setter is compiled for it too).
+  if (const DenseKernels* avx2 = Avx2DenseKernels())
+    avx2->set_cache_sizes(sizes.l1, sizes.l2, sizes.l3);
+}
+
+namespace {
+// At load, before any product of the program (an object file of the library that every
+// factorization links; plugin/dense_kernels.h, kEigenCacheSizes).
+const bool kEigenCacheSizesSet = (SetEigenCacheSizes(kEigenCacheSizes), true);
+}  // namespace
+
 const DenseKernels& ActiveDenseKernels() {
   static const DenseKernels* const active = [] {
     const char* env = std::getenv("TAUT_DENSE_KERNELS");

@@ -8,12 +8,14 @@
 // All matrices are column-major with a leading dimension (ld >= rows); blocks of right-hand sides
 // of the supernodal solves are row-major with `cols` entries per row. The two builds round
 // differently (FMA), so results are bitwise reproducible for one kernel set: determinism pins are
-// kept per set (tests/data/determinism_hashes.txt).
+// kept per set (tests/data/determinism_hashes.txt). Within a set they are the same on every CPU:
+// Eigen's blocking is fixed (kEigenCacheSizes below).
 //
 // TAUT_DENSE_KERNELS=generic (or avx2) in the environment forces a set; an unknown name, or avx2
 // on a CPU or build without it, throws InputError at the first use.
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 namespace taut {
@@ -48,7 +50,25 @@ struct DenseKernels {
   // u_rest -= L_rest u_t; backward u_t = L_tt^-T (u_t - L_rest^T u_rest).
   void (*forward_panel_single)(const float* l, int m, int w, double* u);
   void (*backward_panel_single)(const float* l, int m, int w, double* u);
+  // The cache sizes (bytes) this set's Eigen blocks its products and triangular solves for:
+  // set, and the L1 size in effect.
+  void (*set_cache_sizes)(std::ptrdiff_t l1, std::ptrdiff_t l2, std::ptrdiff_t l3);
+  std::ptrdiff_t (*l1_cache_size)();
 };
+
+// Eigen sizes the blocks of its matrix products and triangular solves from the cache sizes the
+// CPU reports, and the block over a product's depth (from L1) sets its summation order: the same
+// factorization rounded differently on an Intel Xeon (48 KiB L1d) than on an AMD EPYC (32 KiB),
+// and the finger, box_on_sphere and gripper scenes changed their pinned state hashes between the
+// two. taut sets these sizes in both kernel sets when it loads (the generic set's Eigen is the
+// one the rest of taut, and a program linking taut, uses), so results are the same bits on every
+// x86-64 CPU. They are the AMD EPYC's, on which the pins were made.
+struct EigenCacheSizes {
+  std::ptrdiff_t l1, l2, l3;
+};
+inline constexpr EigenCacheSizes kEigenCacheSizes{32 * 1024, 512 * 1024, 32 * 1024 * 1024};
+// Sets the cache sizes of every kernel set this CPU can run (at load: kEigenCacheSizes).
+void SetEigenCacheSizes(const EigenCacheSizes& sizes);
 
 // Eigen splits a product's depth into blocks sized from the CPU's L1 cache and sums the partial
 // results, so a deep product's last bits would depend on the machine; the Delassus products sum

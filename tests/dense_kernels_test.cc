@@ -158,6 +158,34 @@ TEST(DenseKernelsTest, SinglePrecisionPanelSolvesInvertTheFloatPanelInEverySet) 
   }
 }
 
+// Eigen blocks a product's depth by the L1 size it is told, and each block is summed on its own:
+// the cache sizes are part of the result. Every set runs with kEigenCacheSizes from load on, so
+// a product is the same bits on any CPU. Told another CPU's sizes, the same deep product rounds
+// differently: an Intel Xeon's 48 KiB L1d changes the AVX2 set's depth blocks (208 -> 336 of the
+// 1,000), a 64 KiB L1d both sets' (generic 504 -> 1,000).
+TEST(DenseKernelsTest, ProductsRoundForTheFixedCacheSizesOnAnyCpu) {
+  const int m = 24, n = 20, k = 1000;  // k spans several depth blocks for either L1
+  const std::vector<double> a = RandomStorage(m, k, 61), b = RandomStorage(n, k, 62);
+  for (const DenseKernels* set : KernelSetsOfThisMachine()) {
+    SCOPED_TRACE(set->name);
+    EXPECT_EQ(set->l1_cache_size(), kEigenCacheSizes.l1);  // set when taut loaded
+    const auto product = [&] {
+      std::vector<double> c(static_cast<size_t>(m) * n);
+      set->multiply_by_transposed(a.data(), m, b.data(), n, m, n, k, c.data(), m);
+      return c;
+    };
+    const std::vector<double> fixed = product();
+    const std::ptrdiff_t other_l1 = std::string(set->name) == "avx2" ? 48 * 1024 : 64 * 1024;
+    SetEigenCacheSizes({other_l1, 2048 * 1024, 480 * 1024 * 1024});
+    const std::vector<double> other = product();
+    SetEigenCacheSizes(kEigenCacheSizes);
+    EXPECT_NE(other, fixed) << "an L1 of " << other_l1 << " bytes did not change the rounding";
+    EXPECT_EQ(product(), fixed);
+    // Both are the product to round-off.
+    EXPECT_LT((ViewOf(other, m, m, n) - ViewOf(fixed, m, m, n)).cwiseAbs().maxCoeff(), 1e-12);
+  }
+}
+
 TEST(DenseKernelsTest, CholeskyReportsTheFirstColumnWithoutAPositivePivot) {
   for (const DenseKernels* kernels : KernelSetsOfThisMachine()) {
     SCOPED_TRACE(kernels->name);
