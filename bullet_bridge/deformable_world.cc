@@ -285,6 +285,7 @@ void DeformableWorldOf<BulletWorld>::RemoveDeformableBody(DeformableBody* body) 
 template <class BulletWorld>
 int DeformableWorldOf<BulletWorld>::stepSimulation(btScalar time_step, int max_sub_steps,
                                                    btScalar fixed_time_step) {
+  ValidateSqpSettings(solver_settings_);  // before any state moves: a bad setting changes nothing
   call_stats_ = StepStats();
   call_stats_.substeps = 0;
   return BulletWorld::stepSimulation(time_step, max_sub_steps, fixed_time_step);

@@ -128,7 +128,8 @@ class DeformableWorldOf : public BulletWorld {
   void SetContactSurface(DeformableBody* body, const SurfaceMesh& surface);
   // Removes every constraint source (limits) of the body.
   void ClearLimits(DeformableBody* body);
-  // Solver settings used by every constrained body.
+  // Solver settings used by every constrained body; checked by ValidateSqpSettings at each
+  // stepSimulation (InputError naming the field, nothing stepped).
   SqpSettings& mutable_solver_settings() { return solver_settings_; }
   const SqpSettings& solver_settings() const { return solver_settings_; }
   // Threads that step the deformables (default 1: everything on the caller's thread). With n > 1

@@ -4,9 +4,7 @@
 #include <cmath>
 
 namespace taut {
-namespace {
 
-// Throws InputError unless every settings field is in its documented range.
 void ValidatePgsSettings(const PgsSettings& s) {
   TAUT_DEMAND(s.max_sweeps >= 0, "PgsSettings: max_sweeps = ", s.max_sweeps, " must be >= 0");
   TAUT_DEMAND(s.tolerance >= 0.0 && s.residual_tolerance >= 0.0,
@@ -17,6 +15,8 @@ void ValidatePgsSettings(const PgsSettings& s) {
   TAUT_DEMAND(s.min_diagonal >= 0.0 && s.min_diagonal < 1.0,
               "PgsSettings: min_diagonal = ", s.min_diagonal, " must be in [0, 1)");
 }
+
+namespace {
 
 // The sweep state shared by the row kernels: problem, iterate, skip threshold, sweep maximum.
 struct Sweep {

@@ -37,6 +37,9 @@ struct PgsSettings {
                                 // costs O(m) per changed row instead of O(m) per row
 };
 
+// Throws InputError naming the field unless every field of `s` is in its documented range.
+void ValidatePgsSettings(const PgsSettings& s);
+
 // What a SolvePgs call did.
 struct PgsStats {
   int sweeps = 0;            // sweeps run

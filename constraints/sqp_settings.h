@@ -132,4 +132,9 @@ struct SqpSettings {
   int retry_max_iterations = 10;
 };
 
+// Throws InputError naming the field ("SqpSettings::primal.penalty_scale = 0 must be finite and
+// > 0") unless every field of `settings` is in its documented range. DeformableWorld checks its
+// solver settings with it before each stepSimulation, so a bad setting changes no state.
+void ValidateSqpSettings(const SqpSettings& settings);
+
 }  // namespace taut

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "constraints/energy_limits.h"
+#include "constraints/sqp_settings.h"
 #include "constraints/strain_limits.h"
 #include "demos/scenes/bullet_world_holder.h"
 #include "plugin/box_tet_mesher.h"
@@ -550,6 +551,56 @@ TEST(BadInputTest, NonFiniteOrMisSizedStatesAreRejected) {
   v[7] = -kInf;
   ExpectInputError([&] { body->set_v(v); }, {"body 'cube'", "non-finite velocity"});
   ExpectInputError([&] { body->set_v(VecX::Zero(80)); }, {"set_v expects 81 values, got 80"});
+}
+
+// ---- Solver settings (ValidateSqpSettings at DeformableWorld::stepSimulation) ----
+
+// A limited 0.2 m cube resting on the ground: every bad solver setting is rejected at the next
+// stepSimulation naming its field, before anything moves, and the world steps on once the setting
+// is set back.
+TEST(BadInputTest, BadSolverSettingsAreNamedAndStepNothing) {
+  BulletWorldHolder holder;
+  holder.AddStaticGround();
+  DeformableBodySettings body_settings;
+  body_settings.name = "cube";
+  DeformableBody* cube = holder.world.AddTetBody(
+      MakeBoxTetMesh(Vec3(0.2, 0.2, 0.2), 2, 2, 2, Vec3(-0.1, -0.1, 0.001)), body_settings);
+  holder.world.SetStrainLimits(cube, StrainLimitSettings::Isotropic(0.95, 1.05));
+  const double h = 1.0 / 240.0;
+  holder.world.stepSimulation(h, 1, h);
+  const SqpSettings good = holder.world.solver_settings();
+  using Edit = void (*)(SqpSettings&);
+  const std::vector<std::pair<std::string, Edit>> cases = {
+      {"SqpSettings::violation_tolerance = 0", [](SqpSettings& s) { s.violation_tolerance = 0.0; }},
+      {"SqpSettings::contact_tolerance = nan", [](SqpSettings& s) { s.contact_tolerance = kNan; }},
+      {"SqpSettings::stationarity_tolerance = -1",
+       [](SqpSettings& s) { s.stationarity_tolerance = -1.0; }},
+      {"SqpSettings::max_iterations = 0", [](SqpSettings& s) { s.max_iterations = 0; }},
+      {"SqpSettings::stalled_step = 1", [](SqpSettings& s) { s.stalled_step = 1.0; }},
+      {"SqpSettings::pgs: PgsSettings: relaxation = 2",
+       [](SqpSettings& s) { s.pgs.relaxation = 2.0; }},
+      {"SqpSettings::polish.max_rounds = -1", [](SqpSettings& s) { s.polish.max_rounds = -1; }},
+      {"SqpSettings::solver = 7",
+       [](SqpSettings& s) { s.solver = static_cast<IslandSolverKind>(7); }},
+      {"SqpSettings::primal.penalty_scale = 0", [](SqpSettings& s) { s.primal.penalty_scale = 0; }},
+      {"SqpSettings::primal.max_newton_iterations = 0",
+       [](SqpSettings& s) { s.primal.max_newton_iterations = 0; }},
+      {"SqpSettings::primal.penalty_growth = 0.5",
+       [](SqpSettings& s) { s.primal.penalty_growth = 0.5; }},
+      {"SqpSettings::primal.pcg_tolerance = inf",
+       [](SqpSettings& s) { s.primal.pcg_tolerance = kInf; }},
+      {"SqpSettings::retry_max_iterations = 0", [](SqpSettings& s) { s.retry_max_iterations = 0; }},
+  };
+  for (const auto& [message, edit] : cases) {
+    const VecX x = cube->x(), v = cube->v();
+    edit(holder.world.mutable_solver_settings());
+    ExpectInputError([&] { holder.world.stepSimulation(h, 1, h); }, {message});
+    EXPECT_EQ(cube->x(), x) << message;
+    EXPECT_EQ(cube->v(), v) << message;
+    holder.world.mutable_solver_settings() = good;
+    holder.world.stepSimulation(h, 1, h);
+    EXPECT_NE(cube->x(), x) << message << ": the world steps again once the setting is good";
+  }
 }
 
 TEST(BadInputTest, StepArgumentsAreChecked) {
