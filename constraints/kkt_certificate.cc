@@ -47,34 +47,65 @@ void RecordKkt(const KktResiduals& kkt, StepStats& stats) {
   }
 }
 
-double CalcStationarity(const std::vector<IslandBody*>& bodies, const IslandRows& rows,
-                        const VecX& lambda, const std::vector<VecX>& v, VecX& scratch) {
-  double residual = 0.0, force = 0.0, momentum = 0.0;
-  VecX jt;
-  for (size_t b = 0; b < bodies.size(); ++b) {
-    bodies[b]->ApplySystemMatrix(v[b] - bodies[b]->v_star(), scratch);
-    jt.setZero(scratch.size());
-    const int body = static_cast<int>(b);
-    for (int c : rows.body_rows(body))
-      rows[c].ForEachEntry([&](int on, int block, const Vec3& J) {
-        if (on == body) jt.segment<3>(3 * block) += lambda[c] * J;
-      });
-    // Pinned blocks carry reaction forces: compare on free blocks only (A v is 0 there).
-    for (int i = 0; i < bodies[b]->num_blocks(); ++i)
-      if (!bodies[b]->is_free_block(i)) jt.segment<3>(3 * i).setZero();
-    residual += (scratch - jt).squaredNorm();
-    force += jt.squaredNorm();
-    momentum += scratch.squaredNorm();
-  }
-  // Relative to the larger of the two sides, so a velocity change without a constraint force
-  // counts as fully non-stationary (1) whatever the body's mass.
+namespace {
+
+// Adds body b's terms of stationarity: ||A(v - v*) - J^T lambda||^2, ||J^T lambda||^2 and
+// ||A(v - v*)||^2 over its free blocks (pinned blocks carry reaction forces: A v is 0 there).
+void AddStationarityTerms(const IslandBody& body, int b, const IslandRows& rows, const VecX& lambda,
+                          const VecX& a_dv, double& residual, double& force, double& momentum) {
+  VecX jt = VecX::Zero(a_dv.size());
+  for (int c : rows.body_rows(b))
+    rows[c].ForEachEntry([&](int on, int block, const Vec3& J) {
+      if (on == b) jt.segment<3>(3 * block) += lambda[c] * J;
+    });
+  for (int i = 0; i < body.num_blocks(); ++i)
+    if (!body.is_free_block(i)) jt.segment<3>(3 * i).setZero();
+  residual += (a_dv - jt).squaredNorm();
+  force += jt.squaredNorm();
+  momentum += a_dv.squaredNorm();
+}
+
+// Relative to the larger of the two sides, so a velocity change without a constraint force
+// counts as fully non-stationary (1) whatever the body's mass.
+double StationarityFromTerms(double residual, double force, double momentum) {
   const double scale = std::max(force, momentum);
   return scale > 0.0 ? std::sqrt(residual / scale) : 0.0;
 }
 
-KktResiduals CalcKktResiduals(const std::vector<IslandBody*>& bodies, const IslandRows& rows,
-                              const VecX& lambda, const std::vector<VecX>& v, double h,
-                              double distance_scale, VecX& scratch) {
+}  // namespace
+
+void CalcVelocityChangeMomentum(const std::vector<IslandBody*>& bodies, const std::vector<VecX>& v,
+                                std::vector<VecX>& a_dv) {
+  a_dv.resize(bodies.size());
+  for (size_t b = 0; b < bodies.size(); ++b)
+    bodies[b]->ApplySystemMatrix(v[b] - bodies[b]->v_star(), a_dv[b]);
+}
+
+double CalcStationarity(const std::vector<IslandBody*>& bodies, const IslandRows& rows,
+                        const VecX& lambda, const std::vector<VecX>& v, VecX& scratch) {
+  double residual = 0.0, force = 0.0, momentum = 0.0;
+  for (size_t b = 0; b < bodies.size(); ++b) {
+    bodies[b]->ApplySystemMatrix(v[b] - bodies[b]->v_star(), scratch);
+    AddStationarityTerms(*bodies[b], static_cast<int>(b), rows, lambda, scratch, residual, force,
+                         momentum);
+  }
+  return StationarityFromTerms(residual, force, momentum);
+}
+
+double CalcStationarity(const std::vector<IslandBody*>& bodies, const IslandRows& rows,
+                        const VecX& lambda, const std::vector<VecX>& a_dv) {
+  double residual = 0.0, force = 0.0, momentum = 0.0;
+  for (size_t b = 0; b < bodies.size(); ++b)
+    AddStationarityTerms(*bodies[b], static_cast<int>(b), rows, lambda, a_dv[b], residual, force,
+                         momentum);
+  return StationarityFromTerms(residual, force, momentum);
+}
+
+namespace {
+
+// Every residual of (v, lambda) but stationarity.
+KktResiduals CalcRowResiduals(const IslandRows& rows, const VecX& lambda,
+                              const std::vector<VecX>& v, double h, double distance_scale) {
   KktResiduals kkt;
   const double lambda_scale = lambda.size() > 0 ? lambda.cwiseAbs().maxCoeff() : 0.0;
   const double active = 1e-9 * lambda_scale;  // lambda above this counts as pushing
@@ -103,7 +134,24 @@ KktResiduals CalcKktResiduals(const std::vector<IslandBody*>& bodies, const Isla
     }
   }
   kkt.dual = lambda_scale > 0.0 ? std::max(0.0, dual) / lambda_scale : 0.0;
+  return kkt;
+}
+
+}  // namespace
+
+KktResiduals CalcKktResiduals(const std::vector<IslandBody*>& bodies, const IslandRows& rows,
+                              const VecX& lambda, const std::vector<VecX>& v, double h,
+                              double distance_scale, VecX& scratch) {
+  KktResiduals kkt = CalcRowResiduals(rows, lambda, v, h, distance_scale);
   kkt.stationarity = CalcStationarity(bodies, rows, lambda, v, scratch);
+  return kkt;
+}
+
+KktResiduals CalcKktResiduals(const std::vector<IslandBody*>& bodies, const IslandRows& rows,
+                              const VecX& lambda, const std::vector<VecX>& v, double h,
+                              double distance_scale, const std::vector<VecX>& a_dv) {
+  KktResiduals kkt = CalcRowResiduals(rows, lambda, v, h, distance_scale);
+  kkt.stationarity = CalcStationarity(bodies, rows, lambda, a_dv);
   return kkt;
 }
 
@@ -147,16 +195,17 @@ KktResiduals CalcKktResidualsWithRefit(const std::vector<IslandBody*>& bodies,
                                        const IslandRows& rows, const VecX& lambda,
                                        const std::vector<VecX>& v, double h, double distance_scale,
                                        double violation_tolerance, double stationarity_tolerance,
-                                       VecX& scratch, VecX& certified) {
+                                       std::vector<VecX>& a_dv, VecX& certified) {
   certified = lambda;
-  const KktResiduals kkt = CalcKktResiduals(bodies, rows, lambda, v, h, distance_scale, scratch);
+  CalcVelocityChangeMomentum(bodies, v, a_dv);
+  const KktResiduals kkt = CalcKktResiduals(bodies, rows, lambda, v, h, distance_scale, a_dv);
   if (IsCertified(kkt, violation_tolerance, stationarity_tolerance)) return kkt;
   // Friction forces just off the rims of their Coulomb disks (the primal path projects them onto
   // the disks of the previous normal multipliers, which the update moves): the refit starts from
   // the same forces on the rims of the current ones (docs/math.md §5.10).
   KktResiduals start = kkt;
   if (FitFrictionToCurrentDisks(rows, v, h, distance_scale, violation_tolerance, certified)) {
-    start = CalcKktResiduals(bodies, rows, certified, v, h, distance_scale, scratch);
+    start = CalcKktResiduals(bodies, rows, certified, v, h, distance_scale, a_dv);
     if (IsCertified(start, violation_tolerance, stationarity_tolerance)) return start;
   }
   if (start.max_primal() > violation_tolerance || start.dual > 1e-6) {
@@ -164,10 +213,10 @@ KktResiduals CalcKktResidualsWithRefit(const std::vector<IslandBody*>& bodies,
     return kkt;
   }
   // Aim below the tolerance: the refit stops once stationarity is surely within half of it.
-  RefitLimitMultipliers(bodies, rows, v, violation_tolerance, 0.5 * stationarity_tolerance,
+  RefitLimitMultipliers(bodies, rows, a_dv, violation_tolerance, 0.5 * stationarity_tolerance,
                         kRefitSweeps, certified);
   const KktResiduals kkt_refit =
-      CalcKktResiduals(bodies, rows, certified, v, h, distance_scale, scratch);
+      CalcKktResiduals(bodies, rows, certified, v, h, distance_scale, a_dv);
   if (IsCertified(kkt_refit, violation_tolerance, stationarity_tolerance)) return kkt_refit;
   certified = lambda;
   return kkt;

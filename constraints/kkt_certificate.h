@@ -37,6 +37,15 @@ struct KktResiduals {
 KktResiduals CalcKktResiduals(const std::vector<IslandBody*>& bodies, const IslandRows& rows,
                               const VecX& lambda, const std::vector<VecX>& v, double h,
                               double distance_scale, VecX& scratch);
+// The same with a_dv = A (v - v*) per body given (CalcVelocityChangeMomentum at the same v).
+KktResiduals CalcKktResiduals(const std::vector<IslandBody*>& bodies, const IslandRows& rows,
+                              const VecX& lambda, const std::vector<VecX>& v, double h,
+                              double distance_scale, const std::vector<VecX>& a_dv);
+
+// a_dv[b] = A_b (v_b - v*_b) for every body: the momentum side of stationarity, one product with
+// each body's system matrix. A certificate computes it once for all the multipliers it tries.
+void CalcVelocityChangeMomentum(const std::vector<IslandBody*>& bodies, const std::vector<VecX>& v,
+                                std::vector<VecX>& a_dv);
 
 // The residuals of (v, lambda), or, when v is primal and lambda dual feasible but the pair fails
 // the certificate (complementarity or stationarity), those of (v, lambda_fit) if they pass, with
@@ -44,11 +53,13 @@ KktResiduals CalcKktResiduals(const std::vector<IslandBody*>& bodies, const Isla
 // the certificate asks only that SOME multipliers satisfy the KKT conditions with v. `certified`
 // <- the multipliers whose residuals are returned (the forces a solver reports, and the primal
 // path's next warm start on rows at their bounds; docs/math.md §5.10, refitted multipliers).
+// a_dv <- A (v - v*) per body (CalcVelocityChangeMomentum): one product per body, shared by every
+// multiplier vector tried.
 KktResiduals CalcKktResidualsWithRefit(const std::vector<IslandBody*>& bodies,
                                        const IslandRows& rows, const VecX& lambda,
                                        const std::vector<VecX>& v, double h, double distance_scale,
                                        double violation_tolerance, double stationarity_tolerance,
-                                       VecX& scratch, VecX& certified);
+                                       std::vector<VecX>& a_dv, VecX& certified);
 // Sweeps of that refit (a sweep costs about one pass over the rows' Jacobians).
 inline constexpr int kRefitSweeps = 50;
 
@@ -70,5 +81,8 @@ void RecordKkt(const KktResiduals& kkt, StepStats& stats);
 // body (0 when both sides vanish).
 double CalcStationarity(const std::vector<IslandBody*>& bodies, const IslandRows& rows,
                         const VecX& lambda, const std::vector<VecX>& v, VecX& scratch);
+// The same with a_dv = A (v - v*) per body given.
+double CalcStationarity(const std::vector<IslandBody*>& bodies, const IslandRows& rows,
+                        const VecX& lambda, const std::vector<VecX>& a_dv);
 
 }  // namespace taut

@@ -12,14 +12,13 @@ bool IsRefitRow(const ConstraintRow& row) {
 }  // namespace
 
 void RefitLimitMultipliers(const std::vector<IslandBody*>& bodies, const IslandRows& rows,
-                           const std::vector<VecX>& v, double violation_tolerance,
+                           const std::vector<VecX>& a_dv, double violation_tolerance,
                            double target_stationarity, int max_sweeps, VecX& lambda) {
   // Residual r = A (v - v*) - J^T lambda on free blocks (pinned blocks carry reactions).
   const size_t nb = bodies.size();
-  std::vector<VecX> r(nb);
+  std::vector<VecX> r(a_dv.begin(), a_dv.begin() + nb);
   double momentum = 0.0;  // ||A (v - v*)||^2 on free blocks
   for (size_t b = 0; b < nb; ++b) {
-    bodies[b]->ApplySystemMatrix(v[b] - bodies[b]->v_star(), r[b]);
     for (int i = 0; i < bodies[b]->num_blocks(); ++i)
       if (bodies[b]->is_free_block(i))
         momentum += r[b].segment<3>(3 * i).squaredNorm();

@@ -20,9 +20,10 @@ namespace taut {
 // target_stationarity ||A (v - v*)|| (stationarity is then at most target_stationarity), when a
 // sweep changes no multiplier by more than 1e-9 of the largest, or when the residual, falling at
 // the last sweep's rate over the sweeps left, would stay above 2 target_stationarity ||A (v - v*)||
-// (a stall: such a refit cannot certify).
+// (a stall: such a refit cannot certify). a_dv[b] = A_b (v_b - v*_b) at the v the rows were
+// collected at (CalcVelocityChangeMomentum, constraints/kkt_certificate.h).
 void RefitLimitMultipliers(const std::vector<IslandBody*>& bodies, const IslandRows& rows,
-                           const std::vector<VecX>& v, double violation_tolerance,
+                           const std::vector<VecX>& a_dv, double violation_tolerance,
                            double target_stationarity, int max_sweeps, VecX& lambda);
 
 }  // namespace taut

@@ -50,6 +50,13 @@ double ProjectOnInterval(double y, double lo, double hi, double* D) {
   return y;
 }
 
+bool AreSameVelocities(const std::vector<VecX>& a, const std::vector<VecX>& b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i)
+    if (a[i].size() != b[i].size() || a[i] != b[i]) return false;
+  return true;
+}
+
 double LowerBound(const ConstraintRow& row) { return row.bilateral ? row.lo : 0.0; }
 double UpperBound(const ConstraintRow& row) {
   return row.bilateral ? row.hi : std::numeric_limits<double>::infinity();
@@ -200,10 +207,15 @@ void PrimalSolver::CalcProjectedMultipliers() {
 }
 
 void PrimalSolver::CalcGradient(const std::vector<IslandBody*>& bodies) {
+  // A (v - v*) is the certificate's product when it was taken at this v (the same bits).
   const size_t nb = bodies.size();
+  const bool certified_here = AreSameVelocities(a_dv_v_, v_);
   for (size_t b = 0; b < nb; ++b) {
     w_[b] = v_[b] - bodies[b]->v_star();
-    bodies[b]->ApplySystemMatrix(w_[b], aw_[b]);
+    if (certified_here)
+      aw_[b] = a_dv_[b];
+    else
+      bodies[b]->ApplySystemMatrix(w_[b], aw_[b]);
     grad_[b] = aw_[b];
   }
   for (int c = 0; c < rows_.size(); ++c) {
@@ -481,6 +493,7 @@ double PrimalSolver::CalcMerit(const std::vector<IslandBody*>& bodies, const std
   // Phi = 1/2 ||v - v*||_A^2 + sum_c P_c(y_c) / rho_c.
   double energy = 0.0;
   for (size_t b = 0; b < bodies.size(); ++b) {
+    if (v[b] == bodies[b]->v_star()) continue;  // v*: no energy (the start candidate)
     work_[b] = v[b] - bodies[b]->v_star();
     bodies[b]->ApplySystemMatrix(work_[b], hp_[b]);
     energy += 0.5 * work_[b].dot(hp_[b]);
@@ -686,9 +699,10 @@ bool PrimalSolver::IsNewtonIterateCertified(const std::vector<IslandBody*>& bodi
   if (violation_ > settings.violation_tolerance) return false;  // its primal residual
   CalcProjectedMultipliers();
   const double distance_scale = settings.CalcDistanceScale();
-  newton_kkt_ = CalcKktResidualsWithRefit(
-      bodies, rows_, lambda_, v_, h, distance_scale, settings.violation_tolerance,
-      settings.stationarity_tolerance, scratch_, newton_reported_);
+  newton_kkt_ = CalcKktResidualsWithRefit(bodies, rows_, lambda_, v_, h, distance_scale,
+                                          settings.violation_tolerance,
+                                          settings.stationarity_tolerance, a_dv_, newton_reported_);
+  a_dv_v_ = v_;
   const KktResiduals& kkt = newton_kkt_;
   if (!IsCertified(kkt, settings.violation_tolerance, settings.stationarity_tolerance))
     return false;
@@ -801,6 +815,7 @@ void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
       (*list)[b].setZero(start[b].size());
   }
   iterate_ = settings.warm_start ? warm : KeyedMultipliers();
+  a_dv_v_.clear();  // this step's v* and A
   rho_kept_ = false;
   newton_certified_ = false;
   model_steps_off_ = false;
@@ -828,7 +843,8 @@ void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
             ? newton_kkt_
             : CalcKktResidualsWithRefit(bodies, rows_, lambda_bar_, v_, h, distance_scale,
                                         settings.violation_tolerance,
-                                        settings.stationarity_tolerance, scratch_, reported_);
+                                        settings.stationarity_tolerance, a_dv_, reported_);
+    if (!newton_certified_) a_dv_v_ = v_;
     newton_certified_ = false;
     RecordKkt(kkt, stats);
     stats.converged =

@@ -232,7 +232,8 @@ class PrimalSolver {
     }
   };
   BasePoint base_;
-  VecX scratch_;
+  std::vector<VecX> a_dv_;    // A (v - v*) per body at the last certificate's v ...
+  std::vector<VecX> a_dv_v_;  // ... that v (empty: none this step)
 };
 
 }  // namespace taut

@@ -172,7 +172,7 @@ void SqpSolver::Iterate(double h, const std::vector<IslandBody*>& bodies,
     // Certificate of the iterate (constraints/kkt_certificate.h).
     const KktResiduals kkt = CalcKktResidualsWithRefit(
         bodies, rows_, lambda_, v_k_, h, distance_scale, settings.violation_tolerance,
-        settings.stationarity_tolerance, scratch_, reported_);
+        settings.stationarity_tolerance, a_dv_, reported_);
     RecordKkt(kkt, stats);
     const double stationarity = kkt.stationarity;
     const bool force_free = lambda_.cwiseAbs().maxCoeff() == 0.0;

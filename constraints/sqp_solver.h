@@ -144,6 +144,7 @@ class SqpSolver {
   KeyedMultipliers qp_keyed_;       // lambda_QP by key
   std::vector<VecX> v_k_, v_qp_, v_trial_, dv_;
   VecX scratch_, jt_;                // 3N work vectors (A dv, J^T lambda), reused across steps
+  std::vector<VecX> a_dv_;           // A (v_k - v*) per body at the last certificate
   KeyedMultipliers previous_;        // last step's multipliers by key
   bool stalled_infeasible_ = false;  // see stalled_infeasible()
   KeyedMultipliers iterate_;         // this step's lambda_k by key

@@ -92,9 +92,9 @@ struct RefitIsland {
     return CalcKktResiduals(bodies, rows, lambda, v, kRefitH, 1.0, scratch);
   }
   KktResiduals ResidualsWithRefit(const VecX& lambda, VecX& certified) {
-    VecX scratch;
+    std::vector<VecX> a_dv;
     return CalcKktResidualsWithRefit(bodies, rows, lambda, v, kRefitH, 1.0, kRefitTolerance, 1e-2,
-                                     scratch, certified);
+                                     a_dv, certified);
   }
 };
 
@@ -124,6 +124,13 @@ class RefitGroundContact final : public ConstraintSource {
   double mu_;
 };
 
+// A (v - v*) per body of an island at its v: the refit's momentum side.
+std::vector<VecX> MomentumAt(const RefitIsland& island) {
+  std::vector<VecX> a_dv;
+  CalcVelocityChangeMomentum(island.bodies, island.v, a_dv);
+  return a_dv;
+}
+
 // A 1 kg mass sticking on the ground (v = 0) with v* = (-0.5, 0, -1): A (v - v*) = (0.5, 0, 1)
 // is held by lambda_n = 1 and friction (0.5, 0), on the rim of the mu = 0.5 disk.
 struct RefitContactIsland {
@@ -138,11 +145,41 @@ struct RefitContactIsland {
     rows.Collect(kRefitH, bodies, sources, v, 1.0);
   }
   KktResiduals ResidualsWithRefit(const VecX& lambda, VecX& certified) {
-    VecX scratch;
+    std::vector<VecX> a_dv;
     return CalcKktResidualsWithRefit(bodies, rows, lambda, v, kRefitH, 1.0, kRefitTolerance, 1e-2,
-                                     scratch, certified);
+                                     a_dv, certified);
   }
 };
+
+// The certificate computes A (v - v*) once and shares it among the multipliers it tries; the
+// residuals from the shared product are bitwise those of a product per call, and the product it
+// hands back is A (v - v*) at v.
+TEST(LimitMultiplierRefitTest, SharedMomentumGivesTheResidualsOfAProductPerCall) {
+  RefitContactIsland island;
+  island.v[0] = Vec3(0.2, -0.1, 0.3);
+  const VecX lambda = (VecX(3) << 1.0, 0.3, -0.2).finished();
+  VecX scratch;
+  const KktResiduals per_call =
+      CalcKktResiduals(island.bodies, island.rows, lambda, island.v, kRefitH, 1.0, scratch);
+  std::vector<VecX> a_dv;
+  CalcVelocityChangeMomentum(island.bodies, island.v, a_dv);
+  const KktResiduals shared =
+      CalcKktResiduals(island.bodies, island.rows, lambda, island.v, kRefitH, 1.0, a_dv);
+  EXPECT_EQ(shared.stationarity, per_call.stationarity);
+  EXPECT_GT(shared.stationarity, 0.0);
+  EXPECT_EQ(shared.primal, per_call.primal);
+  EXPECT_EQ(shared.complementarity, per_call.complementarity);
+  EXPECT_EQ(shared.dual, per_call.dual);
+  // A = M for this particle: A (v - v*) = m (v - v*).
+  std::vector<VecX> handed_back;
+  VecX certified;
+  CalcKktResidualsWithRefit(island.bodies, island.rows, lambda, island.v, kRefitH, 1.0,
+                            kRefitTolerance, 1e-2, handed_back, certified);
+  ASSERT_EQ(handed_back.size(), 1u);
+  VecX expected;
+  island.bodies[0]->ApplySystemMatrix(island.v[0] - island.body.v_star(), expected);
+  EXPECT_EQ(handed_back[0], expected);
+}
 
 // Friction 2e-5 outside the disk (dual residual 2e-5 > 1e-6): projected onto the disk it is the
 // exact force, certified; sliding with the force it is not.
@@ -223,7 +260,8 @@ TEST(LimitMultiplierRefitTest, ForceOnARowShortOfItsBoundMovesToTheRowAtItsBound
   EXPECT_FALSE(IsCertified(first, kRefitTolerance, 1e-2));
 
   VecX fit = split;
-  RefitLimitMultipliers(island.bodies, island.rows, island.v, kRefitTolerance, 0.0, 100, fit);
+  RefitLimitMultipliers(island.bodies, island.rows, MomentumAt(island), kRefitTolerance, 0.0, 100,
+                        fit);
   EXPECT_EQ(fit[1], 0.0);           // released: C > tolerance
   EXPECT_NEAR(fit[0], 2.0, 1e-12);  // the whole force on the row at its bound
   VecX certified;
@@ -248,7 +286,8 @@ TEST(LimitMultiplierRefitTest, ASlackRowThatAloneHoldsTheBodyIsNotReleasedIntoAC
   EXPECT_LT(refit.stationarity, 1e-12);
 
   VecX fit = lambda;
-  RefitLimitMultipliers(island.bodies, island.rows, island.v, kRefitTolerance, 0.0, 100, fit);
+  RefitLimitMultipliers(island.bodies, island.rows, MomentumAt(island), kRefitTolerance, 0.0, 100,
+                        fit);
   EXPECT_EQ(fit[1], 0.0);
   EXPECT_EQ(fit[0], 0.0);  // +x cannot push against -z: the projection keeps it at 0
 }
@@ -269,7 +308,8 @@ TEST(LimitMultiplierRefitTest, RefitSatisfiesTheNonnegativeLeastSquaresOptimalit
   RefitIsland island(2, 1.5, given);
   island.body.set_v_star((VecX(6) << 0.3, -0.2, -1.0, 0.1, 0.4, -0.7).finished());
   VecX fit = VecX::Constant(12, 0.5);
-  RefitLimitMultipliers(island.bodies, island.rows, island.v, kRefitTolerance, 0.0, 100000, fit);
+  RefitLimitMultipliers(island.bodies, island.rows, MomentumAt(island), kRefitTolerance, 0.0,
+                        100000, fit);
 
   VecX r = 1.5 * (island.v[0] - island.body.v_star());
   for (int c = 0; c < 12; ++c)
