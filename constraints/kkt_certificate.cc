@@ -195,9 +195,10 @@ KktResiduals CalcKktResidualsWithRefit(const std::vector<IslandBody*>& bodies,
                                        const IslandRows& rows, const VecX& lambda,
                                        const std::vector<VecX>& v, double h, double distance_scale,
                                        double violation_tolerance, double stationarity_tolerance,
-                                       std::vector<VecX>& a_dv, VecX& certified) {
+                                       std::vector<VecX>& a_dv, VecX& certified,
+                                       bool a_dv_current) {
   certified = lambda;
-  CalcVelocityChangeMomentum(bodies, v, a_dv);
+  if (!a_dv_current) CalcVelocityChangeMomentum(bodies, v, a_dv);
   const KktResiduals kkt = CalcKktResiduals(bodies, rows, lambda, v, h, distance_scale, a_dv);
   if (IsCertified(kkt, violation_tolerance, stationarity_tolerance)) return kkt;
   // Friction forces just off the rims of their Coulomb disks (the primal path projects them onto

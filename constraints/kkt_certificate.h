@@ -54,12 +54,13 @@ void CalcVelocityChangeMomentum(const std::vector<IslandBody*>& bodies, const st
 // <- the multipliers whose residuals are returned (the forces a solver reports, and the primal
 // path's next warm start on rows at their bounds; docs/math.md §5.10, refitted multipliers).
 // a_dv <- A (v - v*) per body (CalcVelocityChangeMomentum): one product per body, shared by every
-// multiplier vector tried.
+// multiplier vector tried; none when the caller says a_dv holds it already (a_dv_current).
 KktResiduals CalcKktResidualsWithRefit(const std::vector<IslandBody*>& bodies,
                                        const IslandRows& rows, const VecX& lambda,
                                        const std::vector<VecX>& v, double h, double distance_scale,
                                        double violation_tolerance, double stationarity_tolerance,
-                                       std::vector<VecX>& a_dv, VecX& certified);
+                                       std::vector<VecX>& a_dv, VecX& certified,
+                                       bool a_dv_current = false);
 // Sweeps of that refit (a sweep costs about one pass over the rows' Jacobians).
 inline constexpr int kRefitSweeps = 50;
 

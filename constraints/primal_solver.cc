@@ -490,13 +490,20 @@ double PrimalSolver::SearchModelLine(const std::vector<IslandBody*>& bodies, dou
 }
 
 double PrimalSolver::CalcMerit(const std::vector<IslandBody*>& bodies, const std::vector<VecX>& v) {
-  // Phi = 1/2 ||v - v*||_A^2 + sum_c P_c(y_c) / rho_c.
+  // Phi = 1/2 ||v - v*||_A^2 + sum_c P_c(y_c) / rho_c. A (v - v*) is kept for the certificate and
+  // the gradient at the same v (a_dv_); at v* the energy is 0 without a product.
   double energy = 0.0;
-  for (size_t b = 0; b < bodies.size(); ++b) {
-    if (v[b] == bodies[b]->v_star()) continue;  // v*: no energy (the start candidate)
-    work_[b] = v[b] - bodies[b]->v_star();
-    bodies[b]->ApplySystemMatrix(work_[b], hp_[b]);
-    energy += 0.5 * work_[b].dot(hp_[b]);
+  bool at_v_star = true;
+  for (size_t b = 0; b < bodies.size(); ++b) at_v_star = at_v_star && v[b] == bodies[b]->v_star();
+  if (!at_v_star) {
+    if (!AreSameVelocities(a_dv_v_, v)) {
+      CalcVelocityChangeMomentum(bodies, v, a_dv_);
+      a_dv_v_ = v;
+    }
+    for (size_t b = 0; b < bodies.size(); ++b) {
+      work_[b] = v[b] - bodies[b]->v_star();
+      energy += 0.5 * work_[b].dot(a_dv_[b]);
+    }
   }
   return energy + CalcRowMerit(v);
 }
@@ -839,11 +846,11 @@ void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     // residuals are the ones just computed.
     if (newton_certified_) reported_ = newton_reported_;
     const KktResiduals kkt =
-        newton_certified_
-            ? newton_kkt_
-            : CalcKktResidualsWithRefit(bodies, rows_, lambda_bar_, v_, h, distance_scale,
-                                        settings.violation_tolerance,
-                                        settings.stationarity_tolerance, a_dv_, reported_);
+        newton_certified_ ? newton_kkt_
+                          : CalcKktResidualsWithRefit(bodies, rows_, lambda_bar_, v_, h,
+                                                      distance_scale, settings.violation_tolerance,
+                                                      settings.stationarity_tolerance, a_dv_,
+                                                      reported_, AreSameVelocities(a_dv_v_, v_));
     if (!newton_certified_) a_dv_v_ = v_;
     newton_certified_ = false;
     RecordKkt(kkt, stats);
