@@ -12,11 +12,13 @@
 //   CalcEnergy(data, e, x, frame)   U_e [J];  CalcForces(data, e, x, frame): f_e = -dU_e/dx [N]
 //   RestStiffnessBlock(data, e, a, b)   K0_ab [N/m];  MultiplyRestStiffness(data, e, w): K0 w
 //   CalcFrozenStiffness(data, e, R)     R K0 R^T [N/m]
+//   CalcRotatedStiffnessBlocks(data, e, R, scale, blocks)  blocks[kNodes a + b] = scale R K0_ab R^T
 //   CalcDeformationGradient(data, e, x) dx/dX at the element centre
 //   MakeContactSurface(mesh), MakeEmbeddedContactSurface(mesh, surface)
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <memory>
 #include <utility>
 #include <vector>
@@ -97,10 +99,11 @@ class ElementModelImpl : public ElementModel {
   // The per-element kernel of UpdateRotationsAndAddForces: R_e at x into rotations_, f_e into
   // `forces`; returns U_e (gather -> local R, forces, energy).
   double UpdateElement(int e, const VecX& x, Nodes& forces);
-  // The per-element kernel of AddScaledStiffness: block (a, b) of scale R_e K0_e R_e^T.
-  Mat3 CalcScaledStiffnessBlock(int e, int a, int b, double scale) const {
-    const Mat3& R = rotations_[e];
-    return scale * (R * Traits::RestStiffnessBlock(data_, e, a, b) * R.transpose());
+  // The per-element kernel of AddScaledStiffness: the blocks of scale R_e K0_e R_e^T, block (a, b)
+  // at kNodes a + b.
+  using StiffnessBlocks = std::array<Mat3, kNodes * kNodes>;
+  void CalcScaledStiffnessBlocks(int e, double scale, StiffnessBlocks& blocks) const {
+    Traits::CalcRotatedStiffnessBlocks(data_, e, rotations_[e], scale, blocks);
   }
   // f(node of a) += forces[a] for the nodes of element e.
   void ScatterElement(int e, const Nodes& forces, VecX& f) const;
@@ -208,14 +211,14 @@ void ElementModelImpl<Traits>::AddScaledStiffness(double scale, const std::vecto
                                                   double* values) const {
   if (SplitsLoops()) return AddScaledStiffnessSplit(scale, index_map, values);
   constexpr int kEntries = 9 * kNodes * kNodes;
+  StiffnessBlocks blocks;
   for (int e = 0; e < num_elements(); ++e) {
     const int* map = index_map.data() + kEntries * e;
-    for (int a = 0; a < kNodes; ++a) {
-      for (int b = 0; b < kNodes; ++b, map += 9) {
-        const Mat3 K = CalcScaledStiffnessBlock(e, a, b, scale);  // entries column-major
-        for (int k = 0; k < 9; ++k)
-          if (map[k] >= 0) values[map[k]] += K.data()[k];
-      }
+    CalcScaledStiffnessBlocks(e, scale, blocks);
+    for (const Mat3& K : blocks) {  // (a, b) row-major over blocks, entries column-major
+      for (int k = 0; k < 9; ++k)
+        if (map[k] >= 0) values[map[k]] += K.data()[k];
+      map += 9;
     }
   }
 }
@@ -229,13 +232,14 @@ void ElementModelImpl<Traits>::AddScaledStiffnessSplit(double scale,
   stiffness_blocks_.resize(static_cast<size_t>(ne) * kEntries);
   auto chunk = [&](int c) {
     const int end = std::min(ne, (c + 1) * kChunkElements);
+    StiffnessBlocks blocks;
     for (int e = c * kChunkElements; e < end; ++e) {
       double* block = stiffness_blocks_.data() + static_cast<size_t>(kEntries) * e;
-      for (int a = 0; a < kNodes; ++a)
-        for (int b = 0; b < kNodes; ++b, block += 9) {
-          const Mat3 K = CalcScaledStiffnessBlock(e, a, b, scale);
-          std::copy(K.data(), K.data() + 9, block);
-        }
+      CalcScaledStiffnessBlocks(e, scale, blocks);
+      for (const Mat3& K : blocks) {
+        std::copy(K.data(), K.data() + 9, block);
+        block += 9;
+      }
     }
   };
   runner_->RunChunks(num_chunks(), chunk);

@@ -59,6 +59,13 @@ struct HexElementTraits {
   static auto RestStiffnessBlock(const RestData& data, int e, int a, int b) {
     return data.elements[e].stiffness.block<3, 3>(3 * a, 3 * b);
   }
+  // blocks[8 a + b] = scale R K0_ab R^T.
+  static void CalcRotatedStiffnessBlocks(const RestData& data, int e, const Mat3& R, double scale,
+                                         std::array<Mat3, 64>& blocks) {
+    for (int a = 0; a < 8; ++a)
+      for (int b = 0; b < 8; ++b)
+        blocks[8 * a + b] = scale * (R * RestStiffnessBlock(data, e, a, b) * R.transpose());
+  }
   // K_e w, w node-major.
   static Nodes MultiplyRestStiffness(const RestData& data, int e, const Nodes& w) {
     Vec24 packed;

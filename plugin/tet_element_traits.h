@@ -19,6 +19,12 @@ using TetRestStiffness = std::array<Mat3, 16>;
 // The 16 blocks K0_nm of one tet, each exactly as CalcRestStiffnessBlock computes it.
 TetRestStiffness CalcTetRestStiffness(const TetRestElement& rest, const LameParameters& lame);
 
+// blocks[4 n + m] = scale R K0_nm R^T of one tet. With q_n = R r_n and R R^T = I the rest block
+// V (lambda r_n r_m^T + mu r_m r_n^T + mu (r_n . r_m) I) (CalcRestStiffnessBlock) rotates to
+// V (lambda q_n q_m^T + mu q_m q_n^T + mu (r_n . r_m) I); block (m, n) is block (n, m)^T.
+void CalcRotatedTetStiffnessBlocks(const TetRestElement& rest, const LameParameters& lame,
+                                   const Mat3& R, double scale, TetRestStiffness& blocks);
+
 struct TetElementTraits {
   static constexpr int kNodes = 4;
   using Mesh = TetMesh;
@@ -62,6 +68,12 @@ struct TetElementTraits {
 
   static const Mat3& RestStiffnessBlock(const RestData& data, int e, int a, int b) {
     return data.stiffness[e][4 * a + b];
+  }
+  // blocks[4 n + m] = scale R K0_nm R^T (CalcRotatedTetStiffnessBlocks: K0's closed form with
+  // rotated shape gradients, about a quarter of the products of R K0_nm R^T).
+  static void CalcRotatedStiffnessBlocks(const RestData& data, int e, const Mat3& R, double scale,
+                                         TetRestStiffness& blocks) {
+    CalcRotatedTetStiffnessBlocks(data.rest.elements[e], data.lame, R, scale, blocks);
   }
   // (K0 w)_a = sum_b K0_ab w_b.
   static Nodes MultiplyRestStiffness(const RestData& data, int e, const Nodes& w) {

@@ -7,6 +7,7 @@
 #include "plugin/box_tet_mesher.h"
 #include "plugin/signed_svd.h"
 #include "plugin/tet_element_model.h"
+#include "plugin/tet_element_traits.h"
 #include "tests/test_utils.h"
 
 namespace taut {
@@ -115,6 +116,27 @@ TEST(CorotatedTetElementTest, FrozenStiffnessIsDerivativeWithRotationHeld) {
     if (std::abs(eig.eigenvalues()[k]) < 1e-9 * K.norm()) ++zero;
   }
   EXPECT_EQ(zero, 6);
+}
+
+// The assembly's closed form scale R K0_nm R^T = scale V (lambda q_n q_m^T + mu q_m q_n^T +
+// mu (r_n . r_m) I), q_n = R r_n, against the rotated rest blocks, and its exact symmetry.
+TEST(CorotatedTetElementTest, RotatedStiffnessBlocksAreTheRotatedRestBlocks) {
+  std::array<Vec3, 4> X;
+  const TetRestElement rest = MakeRest(X);
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 5; ++trial) {
+    const auto x = RandomState(rng, X, trial == 4);
+    const Mat3 R = CalcPolarRotation(CalcTetDeformationGradient(rest, x));
+    const double scale = 0.37;
+    TetRestStiffness blocks;
+    CalcRotatedTetStiffnessBlocks(rest, kLame, R, scale, blocks);
+    const Mat12 expected = scale * CalcFrozenRotationTetStiffness(rest, kLame, R);
+    Mat12 K;
+    for (int n = 0; n < 4; ++n)
+      for (int m = 0; m < 4; ++m) K.block<3, 3>(3 * n, 3 * m) = blocks[4 * n + m];
+    EXPECT_LT(RelativeError(K, expected), 1e-14) << "trial " << trial;
+    EXPECT_EQ(K, K.transpose()) << "trial " << trial;
+  }
 }
 
 TEST(CorotatedTetElementTest, RigidMotionHasZeroForceAndEnergy) {

@@ -8,6 +8,7 @@
 #include "plugin/box_tet_mesher.h"
 #include "plugin/hex_element_model.h"
 #include "plugin/tet_element_model.h"
+#include "plugin/tet_element_traits.h"
 #include "tests/test_utils.h"
 
 namespace taut {
@@ -60,8 +61,10 @@ TEST(RestStiffnessCacheTest, TetBlocksFollowTheMaterial) {
   }
 }
 
-TEST(RestStiffnessCacheTest, TetAssemblyEqualsFreshFrozenRotationStiffnessBitwise) {
-  // One element per call with an identity index map: values = 0 + scale (R K0 R^T) exactly.
+TEST(RestStiffnessCacheTest, TetAssemblyEqualsTheRotatedClosedFormBitwise) {
+  // One element per call with an identity index map: values = 0 + the closed form's blocks of
+  // scale R K0 R^T exactly (CalcRotatedTetStiffnessBlocks), which are the fresh rotated rest
+  // blocks to round-off.
   const auto mesh = MakeDistortedBoxTetMesh();
   TetElementModel model(mesh, kStiff);
   std::mt19937 rng(3);
@@ -76,12 +79,17 @@ TEST(RestStiffnessCacheTest, TetAssemblyEqualsFreshFrozenRotationStiffnessBitwis
     std::vector<double> values(144, 0.0);
     model.AddScaledStiffness(scale, index_map, values.data());
     const Mat3& R = model.rotation(e);
+    TetRestStiffness blocks;
+    CalcRotatedTetStiffnessBlocks(model.rest().elements[e], model.lame(), R, scale, blocks);
     for (int a = 0; a < 4; ++a) {
       for (int b = 0; b < 4; ++b) {
+        const Eigen::Map<const Mat3> assembled(values.data() + 9 * (4 * a + b));
+        EXPECT_EQ(assembled, blocks[4 * a + b])
+            << "element " << e << " block (" << a << ", " << b << ")";
         const Mat3 fresh =
             scale * (R * CalcRestStiffnessBlock(model.rest().elements[e], model.lame(), a, b) *
                      R.transpose());
-        EXPECT_EQ(Eigen::Map<const Mat3>(values.data() + 9 * (4 * a + b)), fresh)
+        EXPECT_LE((assembled - fresh).norm(), 1e-13 * fresh.norm() + 1e-9)
             << "element " << e << " block (" << a << ", " << b << ")";
       }
     }
