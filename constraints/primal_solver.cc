@@ -706,9 +706,9 @@ bool PrimalSolver::IsNewtonIterateCertified(const std::vector<IslandBody*>& bodi
   if (violation_ > settings.violation_tolerance) return false;  // its primal residual
   CalcProjectedMultipliers();
   const double distance_scale = settings.CalcDistanceScale();
-  newton_kkt_ = CalcKktResidualsWithRefit(bodies, rows_, lambda_, v_, h, distance_scale,
-                                          settings.violation_tolerance,
-                                          settings.stationarity_tolerance, a_dv_, newton_reported_);
+  newton_kkt_ = CalcKktResidualsWithRefit(
+      bodies, rows_, lambda_, v_, h, distance_scale, settings.violation_tolerance,
+      settings.stationarity_tolerance, a_dv_, newton_reported_, AreSameVelocities(a_dv_v_, v_));
   a_dv_v_ = v_;
   const KktResiduals& kkt = newton_kkt_;
   if (!IsCertified(kkt, settings.violation_tolerance, settings.stationarity_tolerance))
