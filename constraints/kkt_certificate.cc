@@ -51,9 +51,11 @@ namespace {
 
 // Adds body b's terms of stationarity: ||A(v - v*) - J^T lambda||^2, ||J^T lambda||^2 and
 // ||A(v - v*)||^2 over its free blocks (pinned blocks carry reaction forces: A v is 0 there).
+// jt: work vector (J^T lambda), one per certificate rather than per body.
 void AddStationarityTerms(const IslandBody& body, int b, const IslandRows& rows, const VecX& lambda,
-                          const VecX& a_dv, double& residual, double& force, double& momentum) {
-  VecX jt = VecX::Zero(a_dv.size());
+                          const VecX& a_dv, VecX& jt, double& residual, double& force,
+                          double& momentum) {
+  jt.setZero(a_dv.size());
   for (int c : rows.body_rows(b))
     rows[c].ForEachEntry([&](int on, int block, const Vec3& J) {
       if (on == b) jt.segment<3>(3 * block) += lambda[c] * J;
@@ -84,10 +86,11 @@ void CalcVelocityChangeMomentum(const std::vector<IslandBody*>& bodies, const st
 double CalcStationarity(const std::vector<IslandBody*>& bodies, const IslandRows& rows,
                         const VecX& lambda, const std::vector<VecX>& v, VecX& scratch) {
   double residual = 0.0, force = 0.0, momentum = 0.0;
+  VecX jt;
   for (size_t b = 0; b < bodies.size(); ++b) {
     bodies[b]->ApplySystemMatrix(v[b] - bodies[b]->v_star(), scratch);
-    AddStationarityTerms(*bodies[b], static_cast<int>(b), rows, lambda, scratch, residual, force,
-                         momentum);
+    AddStationarityTerms(*bodies[b], static_cast<int>(b), rows, lambda, scratch, jt, residual,
+                         force, momentum);
   }
   return StationarityFromTerms(residual, force, momentum);
 }
@@ -95,9 +98,10 @@ double CalcStationarity(const std::vector<IslandBody*>& bodies, const IslandRows
 double CalcStationarity(const std::vector<IslandBody*>& bodies, const IslandRows& rows,
                         const VecX& lambda, const std::vector<VecX>& a_dv) {
   double residual = 0.0, force = 0.0, momentum = 0.0;
+  VecX jt;
   for (size_t b = 0; b < bodies.size(); ++b)
-    AddStationarityTerms(*bodies[b], static_cast<int>(b), rows, lambda, a_dv[b], residual, force,
-                         momentum);
+    AddStationarityTerms(*bodies[b], static_cast<int>(b), rows, lambda, a_dv[b], jt, residual,
+                         force, momentum);
   return StationarityFromTerms(residual, force, momentum);
 }
 
