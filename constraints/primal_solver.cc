@@ -821,7 +821,13 @@ void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     for (auto* list : {&v_, &v_trial_, &d_, &grad_, &work_, &w_, &aw_, &r_, &z_, &p_, &hp_})
       (*list)[b].setZero(start[b].size());
   }
-  iterate_ = settings.warm_start ? warm : KeyedMultipliers();
+  // (Not `c ? warm : KeyedMultipliers()`: clang 14's UBSan at -O1 reads the flag of that
+  // conditional temporary uninitialized and reports a bad bool.)
+  if (settings.warm_start) {
+    iterate_ = warm;
+  } else {
+    iterate_.clear();
+  }
   a_dv_v_.clear();  // this step's v* and A
   rho_kept_ = false;
   newton_certified_ = false;

@@ -417,8 +417,8 @@ TEST(BadInputTest, NanCoordinatesInEveryReaderAreNamedWithTheLine) {
     if (!edits.count(c.name)) continue;
     SCOPED_TRACE(c.name);
     const auto& [from, to] = edits.at(c.name);
-    ExpectInputError([&] { c.parse(Replace(c.text, from, to), c.name); },
-                     {where.at(c.name), "'nan'", "finite"});
+    const std::string text = Replace(c.text, from, to);  // a lambda may not capture a binding
+    ExpectInputError([&] { c.parse(text, c.name); }, {where.at(c.name), "'nan'", "finite"});
   }
 }
 
@@ -435,7 +435,8 @@ TEST(BadInputTest, NodeIndicesOutOfRangeInEveryReaderAreNamed) {
     if (!edits.count(c.name)) continue;
     SCOPED_TRACE(c.name);
     const auto& [from, to, message] = edits.at(c.name);
-    ExpectInputError([&] { c.parse(Replace(c.text, from, to), c.name); }, {message});
+    const std::string text = Replace(c.text, from, to);  // a lambda may not capture a binding
+    ExpectInputError([&] { c.parse(text, c.name); }, {message});
   }
 }
 
