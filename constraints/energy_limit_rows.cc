@@ -45,10 +45,10 @@ double CalcHexElementEnergy(const HexRestElement& rest, const HexNodes& x,
 HexEnergyLimitRow CalcHexEnergyLimitRow(const HexRestElement& rest, const HexNodes& x,
                                         const Mat3& R, double u_max) {
   HexEnergyLimitRow row;
-  row.energy = CalcCorotatedHexEnergy(rest, x, R);
-  row.C = CalcEnergyLimitValue(row.energy, u_max);
   // J = f_e / U_max with f_e = -R K_e (R^T x - X) (docs/math.md §4.5, frozen R).
-  const Vec24 f = CalcCorotatedHexForces(rest, x, R);
+  Vec24 f;
+  row.energy = CalcCorotatedHexForcesAndEnergy(rest, x, R, f);
+  row.C = CalcEnergyLimitValue(row.energy, u_max);
   std::array<Vec3, 8> forces, J;
   for (int n = 0; n < 8; ++n) forces[n] = f.segment<3>(3 * n);
   CalcEnergyLimitJacobian(forces.data(), 8, u_max, J.data());

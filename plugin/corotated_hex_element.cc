@@ -37,6 +37,8 @@ HexRestElement CalcHexRestElement(const HexNodes& X, const LameParameters& lame)
         rest.stiffness.block<3, 3>(3 * a, 3 * b) += det * K;
       }
   }
+  // K_ba = K_ab^T holds to rounding; exactly after this (CalcRotatedHexStiffnessBlocks uses it).
+  rest.stiffness = (0.5 * (rest.stiffness + rest.stiffness.transpose())).eval();
   rest.center_gradients =
       CalcHexShapeGradients(Vec3::Zero()) * CalcHexJacobian(X, Vec3::Zero()).inverse();
   for (int t = 0; t < 2; ++t) rest.tet_rest_inverses[t] = TetEdges(X, t).inverse();
@@ -91,17 +93,38 @@ double CalcCorotatedHexEnergy(const HexRestElement& rest, const HexNodes& x, con
 }
 
 Vec24 CalcCorotatedHexForces(const HexRestElement& rest, const HexNodes& x, const Mat3& R) {
-  const Vec24 Ku = rest.stiffness * CorotatedDisplacement(rest, x, R);
   Vec24 f;
-  for (int a = 0; a < 8; ++a) f.segment<3>(3 * a) = -(R * Ku.segment<3>(3 * a));
+  CalcCorotatedHexForcesAndEnergy(rest, x, R, f);
   return f;
 }
 
+double CalcCorotatedHexForcesAndEnergy(const HexRestElement& rest, const HexNodes& x, const Mat3& R,
+                                       Vec24& forces) {
+  // f_a = -R (K_e u)_a, U = 1/2 u . K_e u.
+  const Vec24 u = CorotatedDisplacement(rest, x, R);
+  const Vec24 Ku = rest.stiffness * u;
+  for (int a = 0; a < 8; ++a) forces.segment<3>(3 * a) = -(R * Ku.segment<3>(3 * a));
+  return 0.5 * u.dot(Ku);
+}
+
+void CalcRotatedHexStiffnessBlocks(const HexRestElement& rest, const Mat3& R, double scale,
+                                   HexStiffnessBlocks& blocks) {
+  const Mat3 scaled_R = scale * R;
+  for (int a = 0; a < 8; ++a)
+    for (int b = a; b < 8; ++b) {
+      // scale R K_ab R^T; block (b, a) = its transpose since K_ba = K_ab^T.
+      const Mat3 K_Rt = rest.stiffness.block<3, 3>(3 * a, 3 * b).lazyProduct(R.transpose());
+      blocks[8 * a + b].noalias() = scaled_R.lazyProduct(K_Rt);
+      if (b != a) blocks[8 * b + a] = blocks[8 * a + b].transpose();
+    }
+}
+
 Mat24 CalcFrozenRotationHexStiffness(const HexRestElement& rest, const Mat3& R) {
+  HexStiffnessBlocks blocks;
+  CalcRotatedHexStiffnessBlocks(rest, R, 1.0, blocks);
   Mat24 K;
   for (int a = 0; a < 8; ++a)
-    for (int b = 0; b < 8; ++b)
-      K.block<3, 3>(3 * a, 3 * b) = R * rest.stiffness.block<3, 3>(3 * a, 3 * b) * R.transpose();
+    for (int b = 0; b < 8; ++b) K.block<3, 3>(3 * a, 3 * b) = blocks[8 * a + b];
   return K;
 }
 

@@ -69,6 +69,19 @@ double CalcCorotatedHexEnergy(const HexRestElement& rest, const HexNodes& x, con
 // f = -R K_e (R^T x - X), node-major [N] (= -dU/dx with R frozen).
 Vec24 CalcCorotatedHexForces(const HexRestElement& rest, const HexNodes& x, const Mat3& R);
 
+// Both of the above from one product K_e u: forces <- f, returns U (the same bits as the two
+// calls).
+double CalcCorotatedHexForcesAndEnergy(const HexRestElement& rest, const HexNodes& x, const Mat3& R,
+                                       Vec24& forces);
+
+// 3x3 blocks of the rotated stiffness, (a, b) at 8 a + b.
+using HexStiffnessBlocks = std::array<Mat3, 64>;
+// blocks[8 a + b] = scale R K_ab R^T. K_e is symmetric (K_ba = K_ab^T exactly, CalcHexRestElement),
+// so the 28 blocks below the diagonal are the transposes of those above it: 36 products of three
+// 3x3 matrices instead of 64.
+void CalcRotatedHexStiffnessBlocks(const HexRestElement& rest, const Mat3& R, double scale,
+                                   HexStiffnessBlocks& blocks);
+
 // Frozen-rotation stiffness R K_e R^T (= -df/dx with R frozen), symmetric PSD [N/m].
 Mat24 CalcFrozenRotationHexStiffness(const HexRestElement& rest, const Mat3& R);
 

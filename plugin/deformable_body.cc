@@ -135,18 +135,23 @@ void DeformableBody::BeginStep(double h, const Vec3& gravity) {
   for (int i = 0; i < num_nodes(); ++i) force_.segment<3>(3 * i) += mass_[i] * gravity;
   // Prescribed velocities: fixed nodes 0, kinematic nodes reach their target at the step end.
   kinematic_v_.setZero();
+  bool any_kinematic = false;
   for (int i = 0; i < num_nodes(); ++i)
-    if (kinds_[i] == NodeKind::kKinematic)
+    if (kinds_[i] == NodeKind::kKinematic) {
       kinematic_v_.segment<3>(3 * i) = (kinematic_targets_[i] - x0_.segment<3>(3 * i)) / h;
+      any_kinematic = true;
+    }
   // A = (1 + h alpha) M + (h beta + h^2) K;  b = M v0 + h f(x0) - (h beta + h^2) K v_kin.
   const double c_M = 1.0 + h * settings_.mass_damping;
   const double c_K = h * settings_.stiffness_damping + h * h;
   system_.Assemble(*model_, mass_, c_M, c_K);
   for (int i = 0; i < num_nodes(); ++i)
     v_star_.segment<3>(3 * i) = mass_[i] * v0_.segment<3>(3 * i) + h * force_.segment<3>(3 * i);
-  scratch_.setZero();
-  model_->AddScaledStiffnessTimes(c_K, kinematic_v_, scratch_);
-  v_star_ -= scratch_;
+  if (any_kinematic) {  // K v_kin = 0 without kinematic nodes: one element pass saved
+    scratch_.setZero();
+    model_->AddScaledStiffnessTimes(c_K, kinematic_v_, scratch_);
+    v_star_ -= scratch_;
+  }
   try {
     last_pcg_iterations_ = system_.SolveStep(v_star_, name(), settings_.factor_reuse);
   } catch (const SimulationError&) {

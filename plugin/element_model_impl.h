@@ -10,6 +10,7 @@
 //   Volume(data, e)                 rest volume [m^3]
 //   CalcFrame(data, e, x)           R of the element at x (and what the kernels reuse with it)
 //   CalcEnergy(data, e, x, frame)   U_e [J];  CalcForces(data, e, x, frame): f_e = -dU_e/dx [N]
+//   CalcForcesAndEnergy(data, e, x, frame, forces)  both at once: forces <- f_e, returns U_e
 //   RestStiffnessBlock(data, e, a, b)   K0_ab [N/m];  MultiplyRestStiffness(data, e, w): K0 w
 //   CalcFrozenStiffness(data, e, R)     R K0 R^T [N/m]
 //   CalcRotatedStiffnessBlocks(data, e, R, scale, blocks)  blocks[kNodes a + b] = scale R K0_ab R^T
@@ -167,8 +168,7 @@ double ElementModelImpl<Traits>::UpdateElement(int e, const VecX& x, Nodes& forc
   const Nodes xe = GatherElement(x, e);
   const typename Traits::Frame frame = Traits::CalcFrame(data_, e, xe);
   rotations_[e] = frame.R;
-  forces = Traits::CalcForces(data_, e, xe, frame);
-  return Traits::CalcEnergy(data_, e, xe, frame);
+  return Traits::CalcForcesAndEnergy(data_, e, xe, frame, forces);
 }
 
 template <typename Traits>
@@ -313,7 +313,8 @@ double ElementModelImpl<Traits>::CalcElementForcesAndStiffnessAlongIn(int e, con
                                                                       double* f_K_f) const {
   const Nodes xe = GatherElement(x, e);
   const typename Traits::Frame frame = Traits::MakeFrame(data_, e, xe, R);
-  const Nodes fe = Traits::CalcForces(data_, e, xe, frame);
+  Nodes fe;
+  const double energy = Traits::CalcForcesAndEnergy(data_, e, xe, frame, fe);
   for (int a = 0; a < kNodes; ++a) forces[a] = fe[a];
   if (f_K_f != nullptr) {
     // f^T R K0 R^T f = w^T K0 w with w_a = R^T f_a (K0 stored at rest).
@@ -324,7 +325,7 @@ double ElementModelImpl<Traits>::CalcElementForcesAndStiffnessAlongIn(int e, con
     for (int a = 0; a < kNodes; ++a) sum += w[a].dot(K0w[a]);
     *f_K_f = sum;
   }
-  return Traits::CalcEnergy(data_, e, xe, frame);
+  return energy;
 }
 
 template <typename Traits>

@@ -48,6 +48,14 @@ struct HexElementTraits {
   static double CalcEnergy(const RestData& data, int e, const Nodes& x, const Frame& frame) {
     return CalcCorotatedHexEnergy(data.elements[e], x, frame.R);
   }
+  // Both from one product K_e u: forces <- f, returns U.
+  static double CalcForcesAndEnergy(const RestData& data, int e, const Nodes& x, const Frame& frame,
+                                    Nodes& forces) {
+    Vec24 f;
+    const double energy = CalcCorotatedHexForcesAndEnergy(data.elements[e], x, frame.R, f);
+    for (int a = 0; a < 8; ++a) forces[a] = f.segment<3>(3 * a);
+    return energy;
+  }
   // f = -R K_e (R^T x - X).
   static Nodes CalcForces(const RestData& data, int e, const Nodes& x, const Frame& frame) {
     const Vec24 f = CalcCorotatedHexForces(data.elements[e], x, frame.R);
@@ -59,12 +67,10 @@ struct HexElementTraits {
   static auto RestStiffnessBlock(const RestData& data, int e, int a, int b) {
     return data.elements[e].stiffness.block<3, 3>(3 * a, 3 * b);
   }
-  // blocks[8 a + b] = scale R K0_ab R^T.
+  // blocks[8 a + b] = scale R K0_ab R^T (the upper blocks, the lower ones by symmetry).
   static void CalcRotatedStiffnessBlocks(const RestData& data, int e, const Mat3& R, double scale,
-                                         std::array<Mat3, 64>& blocks) {
-    for (int a = 0; a < 8; ++a)
-      for (int b = 0; b < 8; ++b)
-        blocks[8 * a + b] = scale * (R * RestStiffnessBlock(data, e, a, b) * R.transpose());
+                                         HexStiffnessBlocks& blocks) {
+    CalcRotatedHexStiffnessBlocks(data.elements[e], R, scale, blocks);
   }
   // K_e w, w node-major.
   static Nodes MultiplyRestStiffness(const RestData& data, int e, const Nodes& w) {

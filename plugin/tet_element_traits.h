@@ -65,6 +65,12 @@ struct TetElementTraits {
   static Nodes CalcForces(const RestData& data, int e, const Nodes& /*x*/, const Frame& frame) {
     return CalcCorotatedTetForces(data.rest.elements[e], data.lame, frame.G, frame.R);
   }
+  // Both: forces <- f, returns Psi.
+  static double CalcForcesAndEnergy(const RestData& data, int e, const Nodes& x, const Frame& frame,
+                                    Nodes& forces) {
+    forces = CalcForces(data, e, x, frame);
+    return CalcEnergy(data, e, x, frame);
+  }
 
   static const Mat3& RestStiffnessBlock(const RestData& data, int e, int a, int b) {
     return data.stiffness[e][4 * a + b];

@@ -101,6 +101,37 @@ TEST(CorotatedHexElementTest, FrozenStiffnessIsMinusForceJacobian) {
   }
 }
 
+TEST(CorotatedHexElementTest, RotatedBlocksFromTheUpperHalfMatchTheFullProduct) {
+  // The 28 lower blocks are taken as transposes of the upper ones (K_e exactly symmetric).
+  std::mt19937 rng(7);
+  for (int trial = 0; trial < 4; ++trial) {
+    const HexRestElement rest = CalcHexRestElement(MakeDistortedHex(rng), kLame);
+    EXPECT_EQ(rest.stiffness, rest.stiffness.transpose());
+    const Mat3 R = testing::RandomRotation(rng);
+    const double scale = 0.37;
+    HexStiffnessBlocks blocks;
+    CalcRotatedHexStiffnessBlocks(rest, R, scale, blocks);
+    for (int a = 0; a < 8; ++a)
+      for (int b = 0; b < 8; ++b) {
+        const Mat3 expected = scale * R * rest.stiffness.block<3, 3>(3 * a, 3 * b) * R.transpose();
+        EXPECT_LT((blocks[8 * a + b] - expected).norm(), 1e-12 * rest.stiffness.norm())
+            << "trial " << trial << " block " << a << ", " << b;
+      }
+  }
+}
+
+TEST(CorotatedHexElementTest, ForcesAndEnergyFromOneProductMatchTheSeparateCalls) {
+  std::mt19937 rng(8);
+  const HexRestElement rest = CalcHexRestElement(MakeDistortedHex(rng), kLame);
+  const HexNodes x = RandomState(rng, rest.X, 0.05);
+  const Mat3 R = CalcHexRotation(rest, x, HexRotationMethod::kCenterPolar);
+  Vec24 f;
+  const double U = CalcCorotatedHexForcesAndEnergy(rest, x, R, f);
+  ASSERT_GT(U, 0.0);
+  EXPECT_EQ(U, CalcCorotatedHexEnergy(rest, x, R));
+  EXPECT_EQ(f, CalcCorotatedHexForces(rest, x, R));
+}
+
 TEST(CorotatedHexElementTest, RestStiffnessIsSymmetricPsdWithSixRigidModes) {
   std::mt19937 rng(3);
   const HexRestElement rest = CalcHexRestElement(MakeDistortedHex(rng), kLame);
