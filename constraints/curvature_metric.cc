@@ -51,11 +51,36 @@ Eigen::Map<const MatX> CurvatureMetric::Block(const ElementBlock& e) const {
   return Eigen::Map<const MatX>(values_.data() + e.offset, 3 * e.num_nodes, 3 * e.num_nodes);
 }
 
+namespace {
+// out_e += B u_e over the element's nodes, B (3k x 3k, column-major at `block`) as the sum of
+// its columns scaled by u_e: fixed-size vector operations (Eigen's general matrix-vector kernel
+// costs about twice as much at these sizes).
+template <int kNodes>
+void AddElementBlockTimes(const double* block, const int* nodes, const VecX& u, VecX& out) {
+  constexpr int n = 3 * kNodes;
+  const Eigen::Map<const Eigen::Matrix<double, n, n>> B(block);
+  Eigen::Matrix<double, n, 1> product = Eigen::Matrix<double, n, 1>::Zero();
+  for (int j = 0; j < kNodes; ++j)
+    for (int d = 0; d < 3; ++d) product += B.col(3 * j + d) * u[3 * nodes[j] + d];
+  for (int a = 0; a < kNodes; ++a)
+    out.segment<3>(3 * nodes[a]) += product.template segment<3>(3 * a);
+}
+}  // namespace
+
 void CurvatureMetric::AddTimes(const std::vector<VecX>& u, std::vector<VecX>& out) const {
   for (const NodeBlock& g : node_blocks_)
     out[g.body].segment<3>(3 * g.a) += g.block * u[g.body].segment<3>(3 * g.b);
   Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 3 * kMaxRowNodes, 1> ue, ge;
   for (const ElementBlock& e : elements_) {
+    const double* block = values_.data() + e.offset;
+    if (e.num_nodes == 4) {  // tets
+      AddElementBlockTimes<4>(block, e.nodes.data(), u[e.body], out[e.body]);
+      continue;
+    }
+    if (e.num_nodes == 8) {  // hexes
+      AddElementBlockTimes<8>(block, e.nodes.data(), u[e.body], out[e.body]);
+      continue;
+    }
     ue.resize(3 * e.num_nodes);
     for (int n = 0; n < e.num_nodes; ++n)
       ue.segment<3>(3 * n) = u[e.body].segment<3>(3 * e.nodes[n]);
