@@ -19,7 +19,7 @@ class DeformableIslandBody final : public IslandBody {
     body_->SolveSystemColumns(columns);
   }
   bool HalfSolvesPay(int num_rows) const override { return body_->HalfSolvesPay(num_rows); }
-  void HalfSolveSystemColumns(const Eigen::Ref<const MatX>& rhs, MatX& z) const override {
+  void HalfSolveSystemColumns(const SparseColumns& rhs, MatX& z) const override {
     body_->HalfSolveSystemColumns(rhs, z);
   }
   void CompleteHalfSolve(const VecX& z, VecX& out) const override {

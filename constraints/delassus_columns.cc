@@ -95,11 +95,7 @@ void DelassusColumns::Build(const std::vector<IslandBody*>& bodies, const Island
     }
     const int num_fresh = static_cast<int>(body.to_solve.size());
     if (num_fresh > 0) {
-      body.fresh.setZero(n_full, num_fresh);
-      for (int f = 0; f < num_fresh; ++f) {
-        const ColumnSource& s = body.next_sources[body.to_solve[f]];
-        for (int i = 0; i < s.count; ++i) body.fresh.col(f).segment<3>(3 * s.blocks[i]) += s.J[i];
-      }
+      GatherFresh(n_full, body);
       SolveFresh(*bodies[b], body);
       columns_solved_ += num_fresh;
     }
@@ -123,9 +119,29 @@ void DelassusColumns::Build(const std::vector<IslandBody*>& bodies, const Island
   }
 }
 
+void DelassusColumns::GatherFresh(int n_full, BodyColumns& body) {
+  // Half solves take the J^T columns as entries (a few DOFs each); full solves a dense block.
+  const int num_fresh = static_cast<int>(body.to_solve.size());
+  if (body.half) {
+    body.fresh_sparse.Clear();
+    for (int f = 0; f < num_fresh; ++f) {
+      const ColumnSource& s = body.next_sources[body.to_solve[f]];
+      for (int i = 0; i < s.count; ++i)
+        for (int d = 0; d < 3; ++d) body.fresh_sparse.Add(3 * s.blocks[i] + d, s.J[i][d]);
+      body.fresh_sparse.EndColumn();
+    }
+    return;
+  }
+  body.fresh.setZero(n_full, num_fresh);
+  for (int f = 0; f < num_fresh; ++f) {
+    const ColumnSource& s = body.next_sources[body.to_solve[f]];
+    for (int i = 0; i < s.count; ++i) body.fresh.col(f).segment<3>(3 * s.blocks[i]) += s.J[i];
+  }
+}
+
 void DelassusColumns::SolveFresh(const IslandBody& island_body, BodyColumns& body) {
   if (body.half)
-    island_body.HalfSolveSystemColumns(body.fresh, body.fresh_solved);
+    island_body.HalfSolveSystemColumns(body.fresh_sparse, body.fresh_solved);
   else
     island_body.SolveSystemColumns(body.fresh);
 }

@@ -64,10 +64,11 @@ class DelassusColumns {
     std::vector<ColumnSource> sources;  // what each column of Y was solved for
     std::vector<std::pair<std::uint64_t, int>> by_key;  // (key, column), sorted by key
     MatX next;                                          // the next Build's Y, swapped in
-    MatX fresh;                                         // right-hand sides of the columns to solve
-    MatX fresh_solved;                                  // their half solves
-    mutable VecX impulse;                               // Z_b lambda
-    mutable VecX impulse_velocity;                      // G^T Z_b lambda
+    MatX fresh;                     // right-hand sides of the columns to solve (full solves)
+    SparseColumns fresh_sparse;     // the same as entries (half solves)
+    MatX fresh_solved;              // their half solves
+    mutable VecX impulse;           // Z_b lambda
+    mutable VecX impulse_velocity;  // G^T Z_b lambda
     std::vector<int> nonzero_rows;  // runs (start, end) of rows where a fresh column is nonzero
     MatX gathered, gathered_fresh;  // those rows of Y and of fresh_solved
     MatX cross;                     // Z^T Z_fresh
@@ -78,6 +79,9 @@ class DelassusColumns {
   static ColumnSource CalcSource(const ConstraintRow& row, int b);
   // Column of the kept Y solved for `source`, -1 if none.
   static int FindKept(const BodyColumns& body, const ColumnSource& source);
+  // The right-hand sides J^T of body.to_solve: body.fresh_sparse for half solves, else the dense
+  // body.fresh (n_full rows).
+  static void GatherFresh(int n_full, BodyColumns& body);
   // body.fresh <- its columns solved: Z = G J^T or Y = A^-1 J^T.
   static void SolveFresh(const IslandBody& island_body, BodyColumns& body);
   // body.next_W for the columns in body.next: entries between kept columns copied from body.W,

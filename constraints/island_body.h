@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "plugin/common.h"
+#include "plugin/sparse_columns.h"
 
 namespace taut {
 
@@ -37,7 +38,8 @@ class IslandBody {
     (void)num_rows;
     return false;
   }
-  virtual void HalfSolveSystemColumns(const Eigen::Ref<const MatX>& rhs, MatX& z) const {
+  // rhs: sparse columns over the body's 3 num_blocks velocity entries.
+  virtual void HalfSolveSystemColumns(const SparseColumns& rhs, MatX& z) const {
     (void)rhs;
     (void)z;
     throw InputError("island body: half solves are not supported");

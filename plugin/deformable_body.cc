@@ -174,7 +174,7 @@ void DeformableBody::SolveSystemColumns(Eigen::Ref<MatX> rhs) {
   system_.SolveColumns(rhs);
 }
 
-void DeformableBody::HalfSolveSystemColumns(const Eigen::Ref<const MatX>& rhs, MatX& z) {
+void DeformableBody::HalfSolveSystemColumns(const SparseColumns& rhs, MatX& z) {
   system_.EnsureCurrentFactor(name());
   system_.HalfSolveColumns(rhs, z);
 }

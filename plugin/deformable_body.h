@@ -119,7 +119,7 @@ class DeformableBody {
   // SolveSystem: z = D^-1/2 L^-1 P rhs with rhs^T A^-1 rhs = z^T z, and out = A^-1 rhs c from
   // z c. Only on the SparseLdlt backend (HalfSolvesPay is false otherwise).
   bool HalfSolvesPay(int num_rows) const { return system_.HalfSolvesPay(num_rows); }
-  void HalfSolveSystemColumns(const Eigen::Ref<const MatX>& rhs, MatX& z);
+  void HalfSolveSystemColumns(const SparseColumns& rhs, MatX& z);
   void CompleteHalfSolve(const VecX& z, Eigen::Ref<VecX> out) const {
     system_.CompleteHalfSolve(z, out);
   }

@@ -221,15 +221,24 @@ bool ImplicitSystem::HalfSolvesPay(int num_rows) const {
          static_cast<double>(num_rows) * num_free_dofs() < 4.0 * ldlt_.nonzeros_in_L();
 }
 
-void ImplicitSystem::HalfSolveColumns(const Eigen::Ref<const MatX>& rhs, MatX& z) const {
+void ImplicitSystem::HalfSolveColumns(const SparseColumns& rhs, MatX& z) const {
   TAUT_DEMAND(supports_half_solve(), "ImplicitSystem: half solves need the SparseLdlt backend");
   const int n = num_free_dofs();
   z.resize(n, rhs.cols());
   if (n == 0) return;
   TAUT_ASSERT(factor_current_);
-  for (Eigen::Index c = 0; c < rhs.cols(); ++c)
-    for (int i = 0; i < n; ++i) z(i, c) = rhs(free_to_dof_[i], c);
-  ldlt_.HalfSolveColumns(z);
+  sparse_free_.Clear();
+  for (int c = 0; c < rhs.cols(); ++c) {
+    for (int e = rhs.start[c]; e < rhs.start[c + 1]; ++e) {
+      TAUT_DEMAND(rhs.index[e] >= 0 && rhs.index[e] < static_cast<int>(dof_to_free_.size()),
+                  "ImplicitSystem: half solve entry at DOF ", rhs.index[e], " of ",
+                  dof_to_free_.size());
+      const int free = dof_to_free_[rhs.index[e]];
+      if (free >= 0) sparse_free_.Add(free, rhs.value[e]);
+    }
+    sparse_free_.EndColumn();
+  }
+  ldlt_.HalfSolveSparseColumns(sparse_free_, z);
 }
 
 void ImplicitSystem::CompleteHalfSolve(const VecX& z, Eigen::Ref<VecX> out) const {

@@ -68,8 +68,9 @@ class ImplicitSystem {
   void Solve(Eigen::Ref<VecX> rhs) const;
   // Same for each column of rhs (3N x k).
   void SolveColumns(Eigen::Ref<MatX> rhs) const;
-  // The halves of A^-1 (SparseLdlt::HalfSolveColumns; the SparseLdlt backend only, see
-  // supports_half_solve): z (num_free x k) = D^-1/2 L^-1 P rhs on free DOFs for rhs (3N x k), so
+  // The halves of A^-1 (SparseLdlt::HalfSolveSparseColumns; the SparseLdlt backend only, see
+  // supports_half_solve): z (num_free x k) = D^-1/2 L^-1 P rhs on free DOFs for the k sparse
+  // columns rhs (indices are DOFs 3 node + axis; entries on constrained DOFs are dropped), so
   // that rhs^T A^-1 rhs = z^T z; CompleteHalfSolve: out (3N) = A^-1 rhs c from z c (constrained
   // DOFs 0). Require factor_is_current().
   bool supports_half_solve() const { return !use_cholmod_; }
@@ -80,7 +81,7 @@ class ImplicitSystem {
   // contact rows, 2,361 free DOFs) 2,113 -> 1,323 ms with half solves; the gripper's finger pads
   // (limit rows solved afresh in every SQP iteration) 1,436 -> 1,709 ms.
   bool HalfSolvesPay(int num_rows) const;
-  void HalfSolveColumns(const Eigen::Ref<const MatX>& rhs, MatX& z) const;
+  void HalfSolveColumns(const SparseColumns& rhs, MatX& z) const;
   void CompleteHalfSolve(const VecX& z, Eigen::Ref<VecX> out) const;
   // rhs (3N) <- P^-1 rhs with the held factor P, this step's A or an earlier step's kept one: an
   // approximate A^-1 for starting guesses, which does not make the next step factor A (unlike
@@ -193,6 +194,7 @@ class ImplicitSystem {
   SparseLdlt newton_ldlt_;
   CholmodCholesky newton_cholmod_;
   mutable VecX rhs_free_;
+  mutable SparseColumns sparse_free_;  // HalfSolveColumns: rhs on free DOFs
   mutable MatX columns_free_;
   mutable VecX product_free_;
 };

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "plugin/common.h"
+#include "plugin/sparse_columns.h"
 #include "plugin/supernodal_cholesky.h"
 
 namespace taut {
@@ -99,6 +100,9 @@ class SparseLdlt {
   // allocate nothing; same errors as Solve.
   void HalfSolveColumns(Eigen::Ref<MatX> B) const;
   void CompleteHalfSolve(Eigen::Ref<VecX> z) const;
+  // HalfSolveColumns for sparse B (indices are rows of A): Z (n x B.cols()) = D^-1/2 L^-1 P B,
+  // the same bits as the dense call on B made dense, without reading or writing B's zeros.
+  void HalfSolveSparseColumns(const SparseColumns& B, Eigen::Ref<MatX> Z) const;
 
   // Number of rows (and columns) of A.
   int rows() const { return n_; }
@@ -184,6 +188,10 @@ class SparseLdlt {
   mutable std::vector<double> work_;
   // HalfSolveColumns: (first nonzero in elimination order, column) of each right-hand side.
   mutable std::vector<std::pair<int, int>> half_order_;
+  // Stage of both half solves: the block of columns [c0, c0 + width) of half_order_, gathered
+  // into work_ by `gather(c, w, w_stride)`, solved forward and scaled into `column(c)`.
+  template <typename Gather, typename Column>
+  void HalfSolveBlock(int c0, int width, const Gather& gather, const Column& column) const;
 };
 
 }  // namespace taut
