@@ -238,7 +238,7 @@ void ImplicitSystem::HalfSolveColumns(const SparseColumns& rhs, MatX& z) const {
     }
     sparse_free_.EndColumn();
   }
-  ldlt_.HalfSolveSparseColumns(sparse_free_, z);
+  ldlt_.HalfSolveColumns(sparse_free_, z);
 }
 
 void ImplicitSystem::CompleteHalfSolve(const VecX& z, Eigen::Ref<VecX> out) const {

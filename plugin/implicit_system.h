@@ -68,7 +68,7 @@ class ImplicitSystem {
   void Solve(Eigen::Ref<VecX> rhs) const;
   // Same for each column of rhs (3N x k).
   void SolveColumns(Eigen::Ref<MatX> rhs) const;
-  // The halves of A^-1 (SparseLdlt::HalfSolveSparseColumns; the SparseLdlt backend only, see
+  // The halves of A^-1 (SparseLdlt::HalfSolveColumns; the SparseLdlt backend only, see
   // supports_half_solve): z (num_free x k) = D^-1/2 L^-1 P rhs on free DOFs for the k sparse
   // columns rhs (indices are DOFs 3 node + axis; entries on constrained DOFs are dropped), so
   // that rhs^T A^-1 rhs = z^T z; CompleteHalfSolve: out (3N) = A^-1 rhs c from z c (constrained

@@ -326,67 +326,7 @@ void SparseLdlt::SolveSupernodal(double* b, Eigen::Index outer_stride, int width
 // Z = D^-1/2 L^-1 P B by blocks of kMaxBlockColumns (the supernodal factor's L is the Cholesky
 // factor, D = I there), left in elimination order. The columns go through in the order of their
 // first nonzero in elimination order, so the columns of one block share most of their paths.
-template <typename Gather, typename Column>
-void SparseLdlt::HalfSolveBlock(int c0, int width, const Gather& gather,
-                                const Column& column) const {
-  // The scalar kernel runs at width 1, 4, 8 or 16 (unused columns zero); the supernodal one at
-  // `width`.
-  const int w_stride = supernodal_  ? width
-                       : width <= 1 ? 1
-                       : width <= 4 ? 4
-                       : width <= 8 ? 8
-                                    : kMaxBlockColumns;
-  double* w = work_.data();
-  gather(w, w_stride);  // w (n x w_stride, row-major) = P B of the block, zero-padded
-  if (supernodal_)
-    supernodal_factor_.SolveLower(w, width);
-  else if (w_stride == 1)
-    SolveLowerBlock<1>();
-  else if (w_stride == 4)
-    SolveLowerBlock<4>();
-  else if (w_stride == 8)
-    SolveLowerBlock<8>();
-  else
-    SolveLowerBlock<kMaxBlockColumns>();
-  // Z = D^-1/2 (L^-1 P B), one square root per row for the whole block.
-  for (int k = 0; k < n_; ++k) {
-    const double d_inv_sqrt = supernodal_ ? 1.0 : std::sqrt(d_inv_[k]);
-    for (int c = 0; c < width; ++c) column(c0 + c)[k] = w[k * w_stride + c] * d_inv_sqrt;
-  }
-}
-
-void SparseLdlt::HalfSolveColumns(Eigen::Ref<MatX> B) const {
-  DemandReadyToSolve(B.rows());
-  TAUT_DEMAND(num_negative_pivots_ == 0, "SparseLdlt: half solve of an indefinite matrix (",
-              num_negative_pivots_, " negative pivots)");
-  const Eigen::Index stride = B.outerStride();
-  const int m = static_cast<int>(B.cols());
-  half_order_.resize(m);
-  for (int c = 0; c < m; ++c) {
-    int first = n_;
-    for (int i = 0; i < n_; ++i)
-      if (B(i, c) != 0.0) first = std::min(first, iperm_[i]);
-    half_order_[c] = {first, c};
-  }
-  std::sort(half_order_.begin(), half_order_.end());
-  auto column = [&](int c) { return B.data() + half_order_[c].second * stride; };
-  for (int c0 = 0; c0 < m; c0 += kMaxBlockColumns) {
-    const int width = std::min(kMaxBlockColumns, m - c0);
-    HalfSolveBlock(
-        c0, width,
-        [&](double* w, int w_stride) {
-          for (int c = 0; c < width; ++c) {
-            const double* b = column(c0 + c);
-            for (int k = 0; k < n_; ++k) w[k * w_stride + c] = b[perm_[k]];
-          }
-          for (int k = 0; k < n_; ++k)
-            for (int c = width; c < w_stride; ++c) w[k * w_stride + c] = 0.0;
-        },
-        column);
-  }
-}
-
-void SparseLdlt::HalfSolveSparseColumns(const SparseColumns& B, Eigen::Ref<MatX> Z) const {
+void SparseLdlt::HalfSolveColumns(const SparseColumns& B, Eigen::Ref<MatX> Z) const {
   DemandReadyToSolve(Z.rows());
   TAUT_DEMAND(num_negative_pivots_ == 0, "SparseLdlt: half solve of an indefinite matrix (",
               num_negative_pivots_, " negative pivots)");
@@ -394,6 +334,8 @@ void SparseLdlt::HalfSolveSparseColumns(const SparseColumns& B, Eigen::Ref<MatX>
   TAUT_DEMAND(Z.cols() == m, "SparseLdlt: half solve of ", m, " sparse columns into ", Z.cols());
   for (int i : B.index)
     TAUT_DEMAND(i >= 0 && i < n_, "SparseLdlt: sparse column entry at row ", i, " of ", n_);
+  // Columns ordered by their first nonzero in elimination order, so a block's forward solve
+  // starts where its columns do.
   half_order_.resize(m);
   for (int c = 0; c < m; ++c) {
     int first = n_;
@@ -402,21 +344,39 @@ void SparseLdlt::HalfSolveSparseColumns(const SparseColumns& B, Eigen::Ref<MatX>
     half_order_[c] = {first, c};
   }
   std::sort(half_order_.begin(), half_order_.end());
-  const Eigen::Index stride = Z.outerStride();
-  auto column = [&](int c) { return Z.data() + half_order_[c].second * stride; };
+  double* w = work_.data();
   for (int c0 = 0; c0 < m; c0 += kMaxBlockColumns) {
     const int width = std::min(kMaxBlockColumns, m - c0);
-    HalfSolveBlock(
-        c0, width,
-        [&](double* w, int w_stride) {
-          std::fill(w, w + static_cast<size_t>(n_) * w_stride, 0.0);
-          for (int c = 0; c < width; ++c) {
-            const int source = half_order_[c0 + c].second;
-            for (int e = B.start[source]; e < B.start[source + 1]; ++e)
-              w[iperm_[B.index[e]] * w_stride + c] += B.value[e];
-          }
-        },
-        column);
+    // The scalar kernel runs at width 1, 4, 8 or 16 (unused columns zero); the supernodal one at
+    // `width`.
+    const int w_stride = supernodal_  ? width
+                         : width <= 1 ? 1
+                         : width <= 4 ? 4
+                         : width <= 8 ? 8
+                                      : kMaxBlockColumns;
+    // w (n x w_stride, row-major) = P B of the block's columns, entries summed in order.
+    std::fill(w, w + static_cast<size_t>(n_) * w_stride, 0.0);
+    for (int c = 0; c < width; ++c) {
+      const int source = half_order_[c0 + c].second;
+      for (int e = B.start[source]; e < B.start[source + 1]; ++e)
+        w[iperm_[B.index[e]] * w_stride + c] += B.value[e];
+    }
+    if (supernodal_)
+      supernodal_factor_.SolveLower(w, width);
+    else if (w_stride == 1)
+      SolveLowerBlock<1>();
+    else if (w_stride == 4)
+      SolveLowerBlock<4>();
+    else if (w_stride == 8)
+      SolveLowerBlock<8>();
+    else
+      SolveLowerBlock<kMaxBlockColumns>();
+    // Z = D^-1/2 (L^-1 P B), one square root per row for the whole block.
+    for (int k = 0; k < n_; ++k) {
+      const double d_inv_sqrt = supernodal_ ? 1.0 : std::sqrt(d_inv_[k]);
+      for (int c = 0; c < width; ++c)
+        Z(k, half_order_[c0 + c].second) = w[k * w_stride + c] * d_inv_sqrt;
+    }
   }
 }
 

@@ -93,16 +93,13 @@ class SparseLdlt {
   void SolveColumns(Eigen::Ref<MatX> B) const;
 
   // The halves of A^-1 for Delassus operators (docs/math.md §5.7): with A = P^T L D L^T P,
-  // B^T A^-1 B = Z^T Z for Z = D^-1/2 L^-1 P B. HalfSolveColumns: B := Z (rows in elimination
-  // order); the forward solve skips the rows where a block of B is zero, so a sparse column costs
-  // its elimination-tree path only. CompleteHalfSolve: z := P^T L^-T D^-1/2 z, so that
-  // CompleteHalfSolve(Z c) = A^-1 B c. Both need positive pivots (InputError otherwise) and
-  // allocate nothing; same errors as Solve.
-  void HalfSolveColumns(Eigen::Ref<MatX> B) const;
+  // B^T A^-1 B = Z^T Z for Z = D^-1/2 L^-1 P B. HalfSolveColumns: Z (n x B.cols(), rows in
+  // elimination order) for the sparse columns B (indices are rows of A); the forward solve skips
+  // the rows where a block of B is zero, so a sparse column costs its elimination-tree path only.
+  // CompleteHalfSolve: z := P^T L^-T D^-1/2 z, so that CompleteHalfSolve(Z c) = A^-1 B c. Both
+  // need positive pivots (InputError otherwise) and allocate nothing; same errors as Solve.
+  void HalfSolveColumns(const SparseColumns& B, Eigen::Ref<MatX> Z) const;
   void CompleteHalfSolve(Eigen::Ref<VecX> z) const;
-  // HalfSolveColumns for sparse B (indices are rows of A): Z (n x B.cols()) = D^-1/2 L^-1 P B,
-  // the same bits as the dense call on B made dense, without reading or writing B's zeros.
-  void HalfSolveSparseColumns(const SparseColumns& B, Eigen::Ref<MatX> Z) const;
 
   // Number of rows (and columns) of A.
   int rows() const { return n_; }
@@ -188,10 +185,6 @@ class SparseLdlt {
   mutable std::vector<double> work_;
   // HalfSolveColumns: (first nonzero in elimination order, column) of each right-hand side.
   mutable std::vector<std::pair<int, int>> half_order_;
-  // Stage of both half solves: the block of columns [c0, c0 + width) of half_order_, gathered
-  // into work_ by `gather(c, w, w_stride)`, solved forward and scaled into `column(c)`.
-  template <typename Gather, typename Column>
-  void HalfSolveBlock(int c0, int width, const Gather& gather, const Column& column) const;
 };
 
 }  // namespace taut

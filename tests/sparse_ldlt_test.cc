@@ -40,6 +40,17 @@ SparseMatrix MakeGridLaplacian(int nx, int ny, int nz, double shift) {
 }
 
 // Random vector with entries in [-1, 1].
+// The nonzero entries of B's columns as sparse columns.
+SparseColumns ToSparseColumns(const MatX& B) {
+  SparseColumns columns;
+  for (Eigen::Index c = 0; c < B.cols(); ++c) {
+    for (Eigen::Index i = 0; i < B.rows(); ++i)
+      if (B(i, c) != 0.0) columns.Add(static_cast<int>(i), B(i, c));
+    columns.EndColumn();
+  }
+  return columns;
+}
+
 VecX MakeRandomVec(int n, unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
@@ -186,7 +197,8 @@ TEST(SparseLdltTest, SolveColumnsEqualsColumnByColumnSolve) {
 }
 
 // B^T A^-1 B = Z^T Z for Z = HalfSolveColumns(B), and CompleteHalfSolve(Z c) = A^-1 B c, for
-// both kernels, sparse columns (as J^T has) and dense ones, every block width.
+// both kernels, sparse columns (as J^T has, one with a repeated index whose entries are summed)
+// and dense ones, every block width.
 TEST(SparseLdltTest, HalfSolvesComposeToTheInverse) {
   const SparseMatrix A = testing::MakeRandomTetBlockSpd(3, 3, 3, 17);
   const int n = static_cast<int>(A.rows());
@@ -197,6 +209,17 @@ TEST(SparseLdltTest, HalfSolvesComposeToTheInverse) {
     B.col(c).setZero();
     B.col(c).segment((11 * c) % (n - 3), 3).setConstant(1.0);
   }
+  SparseColumns columns = ToSparseColumns(B);
+  // Column 22 again with its first entry split in two: the same column.
+  columns.start.pop_back();
+  columns.index.resize(columns.start.back());
+  columns.value.resize(columns.start.back());
+  const int split_row = (11 * 22) % (n - 3);
+  columns.Add(split_row, -0.25);
+  columns.Add(split_row, 1.25);
+  columns.Add(split_row + 1, 1.0);
+  columns.Add(split_row + 2, 1.0);
+  columns.EndColumn();
   const MatX reference = B.transpose() * A_inv * B;
   const VecX c_weights = MakeRandomVec(static_cast<int>(B.cols()), 7);
   const VecX impulse = A_inv * (B * c_weights);
@@ -206,54 +229,21 @@ TEST(SparseLdltTest, HalfSolvesComposeToTheInverse) {
     ldlt.Analyze(A, kernel);
     ASSERT_TRUE(ldlt.Factorize(A));
     for (int width : {1, 3, 4, 8, 23}) {
-      MatX Z = B.leftCols(width);
-      ldlt.HalfSolveColumns(Z);
+      SparseColumns first = columns;
+      first.start.resize(width + 1);
+      first.index.resize(first.start.back());
+      first.value.resize(first.start.back());
+      MatX Z(n, width);
+      ldlt.HalfSolveColumns(first, Z);
       const MatX ref = reference.topLeftCorner(width, width);
       EXPECT_LT((Z.transpose() * Z - ref).norm(), 1e-12 * ref.norm())
           << "supernodal " << ldlt.supernodal() << " width " << width;
     }
-    MatX Z = B;
-    ldlt.HalfSolveColumns(Z);
+    MatX Z(n, B.cols());
+    ldlt.HalfSolveColumns(columns, Z);
     VecX v = Z * c_weights;
     ldlt.CompleteHalfSolve(v);
     EXPECT_LT(CalcRelError(v, impulse), 1e-12) << "supernodal " << ldlt.supernodal();
-  }
-}
-
-// The sparse-column half solve gives the dense one's bits on the same columns made dense, for
-// both kernels and every block width, with a repeated index inside a column (summed in order).
-TEST(SparseLdltTest, SparseColumnHalfSolveMatchesTheDenseOneBitwise) {
-  const SparseMatrix A = testing::MakeRandomTetBlockSpd(3, 3, 3, 19);
-  const int n = static_cast<int>(A.rows());
-  std::mt19937 rng(5);
-  std::uniform_int_distribution<int> row(0, n - 1);
-  std::uniform_real_distribution<double> value(-1.0, 1.0);
-  for (SparseLdlt::Kernel kernel :
-       {SparseLdlt::Kernel::kUpLooking, SparseLdlt::Kernel::kSupernodal}) {
-    SparseLdlt ldlt;
-    ldlt.Analyze(A, kernel);
-    ASSERT_TRUE(ldlt.Factorize(A));
-    for (int width : {1, 3, 4, 8, 23}) {
-      SparseColumns sparse;
-      MatX dense = MatX::Zero(n, width);
-      for (int c = 0; c < width; ++c) {
-        const int node = row(rng) / 3;
-        for (int d = 0; d < 3; ++d) {
-          const int i = std::min(3 * node + d, n - 1);
-          const double v = value(rng);
-          sparse.Add(i, v);
-          dense(i, c) += v;
-        }
-        const int i = std::min(3 * node, n - 1);  // a repeated index
-        sparse.Add(i, 0.5);
-        dense(i, c) += 0.5;
-        sparse.EndColumn();
-      }
-      MatX Z(n, width);
-      ldlt.HalfSolveSparseColumns(sparse, Z);
-      ldlt.HalfSolveColumns(dense);
-      EXPECT_EQ(Z, dense) << "supernodal " << ldlt.supernodal() << " width " << width;
-    }
   }
 }
 
@@ -264,8 +254,9 @@ TEST(SparseLdltTest, HalfSolveRejectsAnIndefiniteMatrix) {
   ldlt.Analyze(A, SparseLdlt::Kernel::kUpLooking);
   ASSERT_TRUE(ldlt.Factorize(A));
   ASSERT_GT(ldlt.num_negative_pivots(), 0);
-  MatX B = MatX::Identity(A.rows(), 2);
-  EXPECT_THROW(ldlt.HalfSolveColumns(B), InputError);
+  const SparseColumns B = ToSparseColumns(MatX::Identity(A.rows(), 2));
+  MatX Z(A.rows(), 2);
+  EXPECT_THROW(ldlt.HalfSolveColumns(B, Z), InputError);
 }
 
 TEST(SparseLdltTest, CountsNegativePivotsOfIndefiniteMatrix) {
