@@ -1,5 +1,10 @@
 #include "plugin/corotated_hex_element.h"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <unordered_map>
+
 #include "plugin/signed_svd.h"
 
 namespace taut {
@@ -18,7 +23,7 @@ HexRestElement CalcHexRestElement(const HexNodes& X, const LameParameters& lame)
   HexRestElement rest;
   rest.X = X;
   rest.volume = 0.0;
-  rest.stiffness.setZero();
+  Mat24 stiffness = Mat24::Zero();
   for (int q = 0; q < 8; ++q) {
     const Vec3 s = HexGaussPoint(q);
     const Mat3 F = CalcHexJacobian(X, s);
@@ -34,15 +39,50 @@ HexRestElement CalcHexRestElement(const HexNodes& X, const LameParameters& lame)
         const Vec3 ga = g.row(a).transpose(), gb = g.row(b).transpose();
         Mat3 K = lame.lambda * ga * gb.transpose() + lame.mu * gb * ga.transpose();
         K.diagonal().array() += lame.mu * ga.dot(gb);
-        rest.stiffness.block<3, 3>(3 * a, 3 * b) += det * K;
+        stiffness.block<3, 3>(3 * a, 3 * b) += det * K;
       }
   }
   // K_ba = K_ab^T holds to rounding; exactly after this (CalcRotatedHexStiffnessBlocks uses it).
-  rest.stiffness = (0.5 * (rest.stiffness + rest.stiffness.transpose())).eval();
+  rest.shared_stiffness = std::make_shared<const Mat24>(0.5 * (stiffness + stiffness.transpose()));
   rest.center_gradients =
       CalcHexShapeGradients(Vec3::Zero()) * CalcHexJacobian(X, Vec3::Zero()).inverse();
   for (int t = 0; t < 2; ++t) rest.tet_rest_inverses[t] = TetEdges(X, t).inverse();
   return rest;
+}
+
+namespace {
+// Hash of K's entries rounded to 2^-24 max|K|: equal matrices up to rounding land in one bucket
+// unless an entry sits on a rounding boundary (then they are not shared, which is only slower).
+std::uint64_t HashRoundedStiffness(const Mat24& K) {
+  const double quantum = std::ldexp(K.cwiseAbs().maxCoeff(), -24);
+  std::uint64_t hash = 1469598103934665603ull;  // FNV-1a
+  if (!(quantum > 0.0)) return hash;            // a zero (or non-finite) K_e: one bucket
+  for (int i = 0; i < 24 * 24; ++i) {
+    const auto rounded = static_cast<std::uint64_t>(std::llround(K.data()[i] / quantum));
+    hash = (hash ^ rounded) * 1099511628211ull;
+  }
+  return hash;
+}
+
+bool StiffnessesAgree(const Mat24& A, const Mat24& B) {
+  const double scale = std::max(A.cwiseAbs().maxCoeff(), B.cwiseAbs().maxCoeff());
+  return (A - B).cwiseAbs().maxCoeff() <= kSharedHexStiffnessTolerance * scale;
+}
+}  // namespace
+
+void ShareEqualHexStiffnesses(std::vector<HexRestElement>& elements) {
+  std::unordered_map<std::uint64_t, std::vector<int>> firsts;  // hash -> elements sharing theirs
+  for (int e = 0; e < static_cast<int>(elements.size()); ++e) {
+    std::vector<int>& candidates = firsts[HashRoundedStiffness(elements[e].stiffness())];
+    bool shared = false;
+    for (int first : candidates)
+      if (StiffnessesAgree(elements[first].stiffness(), elements[e].stiffness())) {
+        elements[e].shared_stiffness = elements[first].shared_stiffness;
+        shared = true;
+        break;
+      }
+    if (!shared) candidates.push_back(e);
+  }
 }
 
 Mat3 CalcHexDeformationGradient(const HexGradients& g, const HexNodes& x) {
@@ -89,7 +129,7 @@ Vec24 CorotatedDisplacement(const HexRestElement& rest, const HexNodes& x, const
 
 double CalcCorotatedHexEnergy(const HexRestElement& rest, const HexNodes& x, const Mat3& R) {
   const Vec24 u = CorotatedDisplacement(rest, x, R);
-  return 0.5 * u.dot(rest.stiffness * u);
+  return 0.5 * u.dot(rest.stiffness() * u);
 }
 
 Vec24 CalcCorotatedHexForces(const HexRestElement& rest, const HexNodes& x, const Mat3& R) {
@@ -102,7 +142,7 @@ double CalcCorotatedHexForcesAndEnergy(const HexRestElement& rest, const HexNode
                                        Vec24& forces) {
   // f_a = -R (K_e u)_a, U = 1/2 u . K_e u.
   const Vec24 u = CorotatedDisplacement(rest, x, R);
-  const Vec24 Ku = rest.stiffness * u;
+  const Vec24 Ku = rest.stiffness() * u;
   for (int a = 0; a < 8; ++a) forces.segment<3>(3 * a) = -(R * Ku.segment<3>(3 * a));
   return 0.5 * u.dot(Ku);
 }
@@ -110,10 +150,11 @@ double CalcCorotatedHexForcesAndEnergy(const HexRestElement& rest, const HexNode
 void CalcRotatedHexStiffnessBlocks(const HexRestElement& rest, const Mat3& R, double scale,
                                    HexStiffnessBlocks& blocks) {
   const Mat3 scaled_R = scale * R;
+  const Mat24& K = rest.stiffness();
   for (int a = 0; a < 8; ++a)
     for (int b = a; b < 8; ++b) {
       // scale R K_ab R^T; block (b, a) = its transpose since K_ba = K_ab^T.
-      const Mat3 K_Rt = rest.stiffness.block<3, 3>(3 * a, 3 * b).lazyProduct(R.transpose());
+      const Mat3 K_Rt = K.block<3, 3>(3 * a, 3 * b).lazyProduct(R.transpose());
       blocks[8 * a + b].noalias() = scaled_R.lazyProduct(K_Rt);
       if (b != a) blocks[8 * b + a] = blocks[8 * a + b].transpose();
     }

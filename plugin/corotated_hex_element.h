@@ -12,6 +12,8 @@
 #pragma once
 
 #include <array>
+#include <memory>
+#include <vector>
 
 #include "plugin/corotated_tet_element.h"
 #include "plugin/hex_lattice.h"
@@ -38,7 +40,10 @@ struct HexRestElement {
   // [X_b - X_a, X_c - X_a, X_d - X_a]^-1 of the inscribed tets {1,4,6,7} and {2,3,5,8} [1/m].
   std::array<Mat3, 2> tet_rest_inverses;
   double volume = 0.0;  // sum_q w_q det F_q [m^3]
-  Mat24 stiffness;      // K_e, node-major xyz [N/m]
+  // K_e, node-major xyz [N/m]; one matrix for the elements that ShareEqualHexStiffnesses found
+  // equal (a lattice's cells: the step streams one K_e instead of 4.6 kB per element).
+  std::shared_ptr<const Mat24> shared_stiffness;
+  const Mat24& stiffness() const { return *shared_stiffness; }
 };
 
 // Local nodes (0-based) of the inscribed tets: {1,4,6,7} -> {0,3,5,6}, {2,3,5,8} -> {1,2,4,7}.
@@ -47,6 +52,14 @@ inline constexpr int kHexInscribedTets[2][4] = {{0, 3, 5, 6}, {1, 2, 4, 7}};
 // Precomputes gradients, weights and K_e of a hex with rest nodes X (throws InputError if
 // det F_q <= 0 at a Gauss point).
 HexRestElement CalcHexRestElement(const HexNodes& X, const LameParameters& lame);
+
+// Elements whose K_e agree within kSharedHexStiffnessTolerance max|K_e| in every entry point to
+// the first such element's K_e. Equal cells of a lattice differ in X_a - X_0 by the rounding of
+// X, ulp(|X|) / edge relative (2e-12 for 0.1 m cells 1 km from the origin), and their K_e as
+// much; the tolerance is a rest shape moved by 1e-9 of its size. Elements keep their own
+// gradients and rest positions.
+inline constexpr double kSharedHexStiffnessTolerance = 1e-9;
+void ShareEqualHexStiffnesses(std::vector<HexRestElement>& elements);
 
 // G = sum_a x_a g_a^T for gradients g (one row per node).
 Mat3 CalcHexDeformationGradient(const HexGradients& g, const HexNodes& x);

@@ -16,6 +16,7 @@ HexElementTraits::RestData HexElementTraits::CalcRestData(const HexLattice& latt
     for (int a = 0; a < 8; ++a) X[a] = lattice.nodes[hex[a]];
     data.elements.push_back(CalcHexRestElement(X, data.lame));
   }
+  ShareEqualHexStiffnesses(data.elements);
   return data;
 }
 

@@ -65,7 +65,7 @@ struct HexElementTraits {
   }
 
   static auto RestStiffnessBlock(const RestData& data, int e, int a, int b) {
-    return data.elements[e].stiffness.block<3, 3>(3 * a, 3 * b);
+    return data.elements[e].stiffness().block<3, 3>(3 * a, 3 * b);
   }
   // blocks[8 a + b] = scale R K0_ab R^T (the upper blocks, the lower ones by symmetry).
   static void CalcRotatedStiffnessBlocks(const RestData& data, int e, const Mat3& R, double scale,
@@ -76,7 +76,7 @@ struct HexElementTraits {
   static Nodes MultiplyRestStiffness(const RestData& data, int e, const Nodes& w) {
     Vec24 packed;
     for (int b = 0; b < 8; ++b) packed.segment<3>(3 * b) = w[b];
-    const Vec24 Kw = data.elements[e].stiffness * packed;
+    const Vec24 Kw = data.elements[e].stiffness() * packed;
     Nodes K0w;
     for (int a = 0; a < 8; ++a) K0w[a] = Kw.segment<3>(3 * a);
     return K0w;

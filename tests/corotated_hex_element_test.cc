@@ -106,15 +106,16 @@ TEST(CorotatedHexElementTest, RotatedBlocksFromTheUpperHalfMatchTheFullProduct) 
   std::mt19937 rng(7);
   for (int trial = 0; trial < 4; ++trial) {
     const HexRestElement rest = CalcHexRestElement(MakeDistortedHex(rng), kLame);
-    EXPECT_EQ(rest.stiffness, rest.stiffness.transpose());
+    EXPECT_EQ(rest.stiffness(), rest.stiffness().transpose());
     const Mat3 R = testing::RandomRotation(rng);
     const double scale = 0.37;
     HexStiffnessBlocks blocks;
     CalcRotatedHexStiffnessBlocks(rest, R, scale, blocks);
     for (int a = 0; a < 8; ++a)
       for (int b = 0; b < 8; ++b) {
-        const Mat3 expected = scale * R * rest.stiffness.block<3, 3>(3 * a, 3 * b) * R.transpose();
-        EXPECT_LT((blocks[8 * a + b] - expected).norm(), 1e-12 * rest.stiffness.norm())
+        const Mat3 expected =
+            scale * R * rest.stiffness().block<3, 3>(3 * a, 3 * b) * R.transpose();
+        EXPECT_LT((blocks[8 * a + b] - expected).norm(), 1e-12 * rest.stiffness().norm())
             << "trial " << trial << " block " << a << ", " << b;
       }
   }
@@ -132,10 +133,42 @@ TEST(CorotatedHexElementTest, ForcesAndEnergyFromOneProductMatchTheSeparateCalls
   EXPECT_EQ(f, CalcCorotatedHexForces(rest, x, R));
 }
 
+TEST(CorotatedHexElementTest, EqualCellsShareOneStiffnessAndDistortedOnesKeepTheirOwn) {
+  // A lattice 1 km from the origin: its cells' X_a - X_0 differ in the last bits (ulp(1234.5) /
+  // 0.1 = 2e-12), their K_e by as much, so they share one; a cell with a moved node keeps its own.
+  HexLattice lattice = MakeBoxHexLattice(Vec3(0.3, 0.2, 0.1), 3, 2, 1, Vec3(1234.5, -77.25, 3.1));
+  lattice.nodes[0] += Vec3(0.01, 0.0, 0.0);  // a corner of cell 0 only
+  std::vector<HexRestElement> own, shared;
+  for (const auto& hex : lattice.hexes) {
+    HexNodes X;
+    for (int a = 0; a < 8; ++a) X[a] = lattice.nodes[hex[a]];
+    own.push_back(CalcHexRestElement(X, kLame));
+  }
+  shared = own;
+  for (auto& rest : shared)  // copies share the matrix; give each its own again
+    rest.shared_stiffness = std::make_shared<const Mat24>(rest.stiffness());
+  ShareEqualHexStiffnesses(shared);
+  EXPECT_EQ(shared[0].shared_stiffness.use_count(), 1) << "the distorted cell";
+  for (int e = 2; e < static_cast<int>(shared.size()); ++e)
+    EXPECT_EQ(shared[e].shared_stiffness, shared[1].shared_stiffness) << "cell " << e;
+  std::mt19937 rng(9);
+  for (int e = 0; e < static_cast<int>(shared.size()); ++e) {
+    const double scale = own[e].stiffness().cwiseAbs().maxCoeff();
+    EXPECT_LE((shared[e].stiffness() - own[e].stiffness()).cwiseAbs().maxCoeff(),
+              kSharedHexStiffnessTolerance * scale)
+        << "cell " << e;
+    const HexNodes x = RandomState(rng, own[e].X, 0.05);
+    const Mat3 R = CalcHexRotation(own[e], x, HexRotationMethod::kCenterPolar);
+    const Vec24 f_own = CalcCorotatedHexForces(own[e], x, R);
+    EXPECT_LE((CalcCorotatedHexForces(shared[e], x, R) - f_own).norm(), 1e-8 * f_own.norm())
+        << "cell " << e;
+  }
+}
+
 TEST(CorotatedHexElementTest, RestStiffnessIsSymmetricPsdWithSixRigidModes) {
   std::mt19937 rng(3);
   const HexRestElement rest = CalcHexRestElement(MakeDistortedHex(rng), kLame);
-  const Mat24& K = rest.stiffness;
+  const Mat24& K = rest.stiffness();
   EXPECT_LT((K - K.transpose()).norm(), 1e-12 * K.norm());
   const Eigen::SelfAdjointEigenSolver<Mat24> eig(K);
   const auto& ev = eig.eigenvalues();  // ascending
