@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <unordered_map>
 
+#include "plugin/dense_kernels.h"
 #include "plugin/signed_svd.h"
 
 namespace taut {
@@ -129,7 +130,9 @@ Vec24 CorotatedDisplacement(const HexRestElement& rest, const HexNodes& x, const
 
 double CalcCorotatedHexEnergy(const HexRestElement& rest, const HexNodes& x, const Mat3& R) {
   const Vec24 u = CorotatedDisplacement(rest, x, R);
-  return 0.5 * u.dot(rest.stiffness() * u);
+  Vec24 Ku;
+  ActiveDenseKernels().multiply_hex_stiffness(rest.stiffness().data(), u.data(), Ku.data());
+  return 0.5 * u.dot(Ku);
 }
 
 Vec24 CalcCorotatedHexForces(const HexRestElement& rest, const HexNodes& x, const Mat3& R) {
@@ -142,22 +145,17 @@ double CalcCorotatedHexForcesAndEnergy(const HexRestElement& rest, const HexNode
                                        Vec24& forces) {
   // f_a = -R (K_e u)_a, U = 1/2 u . K_e u.
   const Vec24 u = CorotatedDisplacement(rest, x, R);
-  const Vec24 Ku = rest.stiffness() * u;
+  Vec24 Ku;
+  ActiveDenseKernels().multiply_hex_stiffness(rest.stiffness().data(), u.data(), Ku.data());
   for (int a = 0; a < 8; ++a) forces.segment<3>(3 * a) = -(R * Ku.segment<3>(3 * a));
   return 0.5 * u.dot(Ku);
 }
 
 void CalcRotatedHexStiffnessBlocks(const HexRestElement& rest, const Mat3& R, double scale,
                                    HexStiffnessBlocks& blocks) {
-  const Mat3 scaled_R = scale * R;
-  const Mat24& K = rest.stiffness();
-  for (int a = 0; a < 8; ++a)
-    for (int b = a; b < 8; ++b) {
-      // scale R K_ab R^T; block (b, a) = its transpose since K_ba = K_ab^T.
-      const Mat3 K_Rt = K.block<3, 3>(3 * a, 3 * b).lazyProduct(R.transpose());
-      blocks[8 * a + b].noalias() = scaled_R.lazyProduct(K_Rt);
-      if (b != a) blocks[8 * b + a] = blocks[8 * a + b].transpose();
-    }
+  static_assert(sizeof(HexStiffnessBlocks) == 64 * 9 * sizeof(double), "blocks are contiguous");
+  ActiveDenseKernels().rotate_hex_stiffness_blocks(rest.stiffness().data(), R.data(), scale,
+                                                   blocks[0].data());
 }
 
 Mat24 CalcFrozenRotationHexStiffness(const HexRestElement& rest, const Mat3& R) {

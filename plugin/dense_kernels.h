@@ -50,6 +50,12 @@ struct DenseKernels {
   // u_rest -= L_rest u_t; backward u_t = L_tt^-T (u_t - L_rest^T u_rest).
   void (*forward_panel_single)(const float* l, int m, int w, double* u);
   void (*backward_panel_single)(const float* l, int m, int w, double* u);
+  // The co-rotated hex element (corotated_hex_element.h), K_e 24 x 24 column-major: Ku = K_e u
+  // (its forces and energy), and blocks (64 column-major 3x3, (a, b) at 9 (8 a + b)) =
+  // scale R K_ab R^T for a <= b, the blocks below their transposes (K_e symmetric).
+  void (*multiply_hex_stiffness)(const double* K, const double* u, double* Ku);
+  void (*rotate_hex_stiffness_blocks)(const double* K, const double* R, double scale,
+                                      double* blocks);
   // The cache sizes (bytes) this set's Eigen blocks its products and triangular solves for:
   // set, and the L1 size in effect.
   void (*set_cache_sizes)(std::ptrdiff_t l1, std::ptrdiff_t l2, std::ptrdiff_t l3);

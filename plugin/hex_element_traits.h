@@ -7,6 +7,7 @@
 
 #include "plugin/contact_surface.h"
 #include "plugin/corotated_hex_element.h"
+#include "plugin/dense_kernels.h"
 #include "plugin/material.h"
 
 namespace taut {
@@ -76,7 +77,9 @@ struct HexElementTraits {
   static Nodes MultiplyRestStiffness(const RestData& data, int e, const Nodes& w) {
     Vec24 packed;
     for (int b = 0; b < 8; ++b) packed.segment<3>(3 * b) = w[b];
-    const Vec24 Kw = data.elements[e].stiffness() * packed;
+    Vec24 Kw;
+    ActiveDenseKernels().multiply_hex_stiffness(data.elements[e].stiffness().data(), packed.data(),
+                                                Kw.data());
     Nodes K0w;
     for (int a = 0; a < 8; ++a) K0w[a] = Kw.segment<3>(3 * a);
     return K0w;

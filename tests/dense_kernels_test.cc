@@ -7,6 +7,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <cstdlib>
 #include <string>
 #include <vector>
@@ -79,6 +80,34 @@ TEST(DenseKernelsTest, ProductsMatchPlainLoopsInEverySet) {
         EXPECT_NEAR(aa(i, j), sum, 1e-12 * d) << "both triangles";
       }
     }
+  }
+}
+
+TEST(DenseKernelsTest, HexElementKernelsMatchPlainLoopsInEverySet) {
+  // K (24 x 24) symmetric as the hex element's K_e, R a rotation, u random.
+  Eigen::MatrixXd K = RandomSpd(24, 5);
+  const Eigen::VectorXd u = Eigen::VectorXd::Random(24);
+  const Eigen::Matrix3d R =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1.0, -2.0, 0.5).normalized()).toRotationMatrix();
+  const double scale = 0.37;
+  for (const DenseKernels* kernels : KernelSetsOfThisMachine()) {
+    SCOPED_TRACE(kernels->name);
+    Eigen::VectorXd Ku(24);
+    kernels->multiply_hex_stiffness(K.data(), u.data(), Ku.data());
+    for (int i = 0; i < 24; ++i) {
+      double sum = 0.0;
+      for (int j = 0; j < 24; ++j) sum += K(i, j) * u[j];
+      EXPECT_NEAR(Ku[i], sum, 1e-12 * 24 * K.norm()) << "row " << i;
+    }
+    std::vector<double> blocks(64 * 9, 0.0);
+    kernels->rotate_hex_stiffness_blocks(K.data(), R.data(), scale, blocks.data());
+    for (int a = 0; a < 8; ++a)
+      for (int b = 0; b < 8; ++b) {
+        const Eigen::Matrix3d expected =
+            scale * R * K.block<3, 3>(3 * a, 3 * b) * R.transpose();  // every block, both halves
+        const Eigen::Map<const Eigen::Matrix3d> block(blocks.data() + 9 * (8 * a + b));
+        EXPECT_LT((block - expected).norm(), 1e-13 * K.norm()) << "block " << a << ", " << b;
+      }
   }
 }
 
