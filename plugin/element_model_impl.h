@@ -93,10 +93,18 @@ class ElementModelImpl : public ElementModel {
   // UpdateRotationsAndAddForces on the runner's threads: R, f_e and U_e per element into
   // rotations_, element_forces_ and element_energy_, then the serial loop's sums.
   double UpdateRotationsAndAddForcesSplit(const VecX& x, VecX& f);
-  // AddScaledStiffness on the runner's threads: the blocks of scale R K0 R^T per element into
-  // stiffness_blocks_, then added to `values` in the serial loop's order.
+  // AddScaledStiffness on the runner's threads, each adding the block rows of the nodes it owns
+  // (RowOwners): a value of A (one row node) is added to by one thread, element by element in
+  // the serial loop's order, so the sum is bitwise the serial one.
   void AddScaledStiffnessSplit(double scale, const std::vector<int>& index_map,
                                double* values) const;
+  // Contiguous node ranges, one per loop thread, with about equal numbers of (element, node)
+  // pairs, and the elements with a node in each range, in element order.
+  struct RowOwners {
+    std::vector<int> first_node;             // (parts + 1): part p owns [first_node[p], ...[p+1])
+    std::vector<std::vector<int>> elements;  // (parts) elements touching part p's nodes
+  };
+  const RowOwners& RowOwnersFor(int parts) const;
   // The per-element kernel of UpdateRotationsAndAddForces: R_e at x into rotations_, f_e into
   // `forces`; returns U_e (gather -> local R, forces, energy).
   double UpdateElement(int e, const VecX& x, Nodes& forces);
@@ -116,7 +124,7 @@ class ElementModelImpl : public ElementModel {
   // Per-element results of the split loops (allocated on their first use).
   std::vector<Nodes> element_forces_;
   std::vector<double> element_energy_;
-  mutable std::vector<double> stiffness_blocks_;  // 9 kNodes^2 per element, the serial order
+  mutable RowOwners row_owners_;  // RowOwnersFor, made on the first split assembly
 };
 
 template <typename Traits>
@@ -224,30 +232,57 @@ void ElementModelImpl<Traits>::AddScaledStiffness(double scale, const std::vecto
 }
 
 template <typename Traits>
+auto ElementModelImpl<Traits>::RowOwnersFor(int parts) const -> const RowOwners& {
+  if (static_cast<int>(row_owners_.elements.size()) == parts) return row_owners_;
+  const int nn = num_nodes(), ne = num_elements();
+  std::vector<int> pairs_of_node(nn, 0);  // (element, node) pairs per node
+  for (int e = 0; e < ne; ++e)
+    for (int n : Traits::Elements(*mesh_)[e]) ++pairs_of_node[n];
+  row_owners_.first_node.assign(1, 0);
+  long long seen = 0;
+  const long long total = static_cast<long long>(ne) * kNodes;
+  for (int n = 0; n < nn && static_cast<int>(row_owners_.first_node.size()) < parts; ++n) {
+    seen += pairs_of_node[n];
+    if (seen * parts >= total * static_cast<long long>(row_owners_.first_node.size()))
+      row_owners_.first_node.push_back(n + 1);
+  }
+  while (static_cast<int>(row_owners_.first_node.size()) <= parts)
+    row_owners_.first_node.push_back(nn);
+  row_owners_.elements.assign(parts, {});
+  for (int p = 0; p < parts; ++p)
+    for (int e = 0; e < ne; ++e)
+      for (int n : Traits::Elements(*mesh_)[e])
+        if (n >= row_owners_.first_node[p] && n < row_owners_.first_node[p + 1]) {
+          row_owners_.elements[p].push_back(e);
+          break;
+        }
+  return row_owners_;
+}
+
+template <typename Traits>
 void ElementModelImpl<Traits>::AddScaledStiffnessSplit(double scale,
                                                        const std::vector<int>& index_map,
                                                        double* values) const {
   constexpr int kEntries = 9 * kNodes * kNodes;
-  const int ne = num_elements();
-  stiffness_blocks_.resize(static_cast<size_t>(ne) * kEntries);
-  auto chunk = [&](int c) {
-    const int end = std::min(ne, (c + 1) * kChunkElements);
+  const RowOwners& owners = RowOwnersFor(runner_->num_loop_threads());
+  auto part = [&](int p) {
+    const int first = owners.first_node[p], last = owners.first_node[p + 1];
     StiffnessBlocks blocks;
-    for (int e = c * kChunkElements; e < end; ++e) {
-      double* block = stiffness_blocks_.data() + static_cast<size_t>(kEntries) * e;
+    for (int e : owners.elements[p]) {
       CalcScaledStiffnessBlocks(e, scale, blocks);
-      for (const Mat3& K : blocks) {
-        std::copy(K.data(), K.data() + 9, block);
-        block += 9;
+      const auto& element = Traits::Elements(*mesh_)[e];
+      for (int a = 0; a < kNodes; ++a) {
+        if (element[a] < first || element[a] >= last) continue;  // another part's rows
+        const int* map = index_map.data() + kEntries * e + 9 * kNodes * a;
+        for (int b = 0; b < kNodes; ++b, map += 9) {
+          const double* K = blocks[kNodes * a + b].data();
+          for (int k = 0; k < 9; ++k)
+            if (map[k] >= 0) values[map[k]] += K[k];
+        }
       }
     }
   };
-  runner_->RunChunks(num_chunks(), chunk);
-  // The serial loop's additions, in its order (element, block, entry).
-  const int* map = index_map.data();
-  const double* block = stiffness_blocks_.data();
-  for (size_t k = 0; k < stiffness_blocks_.size(); ++k)
-    if (map[k] >= 0) values[map[k]] += block[k];
+  runner_->RunChunks(static_cast<int>(owners.elements.size()), part);
 }
 
 template <typename Traits>

@@ -18,7 +18,8 @@ namespace {
 // Runs the chunks on the calling thread, last to first, and counts them.
 class ReversedRunner : public ElementLoopRunner {
  public:
-  int num_loop_threads() const override { return 2; }
+  explicit ReversedRunner(int threads = 2) : threads_(threads) {}
+  int num_loop_threads() const override { return threads_; }
   int chunks_run = 0;
 
  protected:
@@ -28,6 +29,9 @@ class ReversedRunner : public ElementLoopRunner {
       ++chunks_run;
     }
   }
+
+ private:
+  int threads_;
 };
 
 std::unique_ptr<DeformableBody> MakeTetBeam() {
@@ -93,6 +97,15 @@ TEST(ElementLoopRunnerTest, HexBodyOnReversedChunksIsBitwiseTheSerialBody) {
   auto body = MakeHexBall(), reference = MakeHexBall();
   ASSERT_GE(body->model().num_elements(), 64);
   ReversedRunner runner;
+  ExpectSameSteps(*body, *reference, &runner);
+  EXPECT_GT(runner.chunks_run, 0);
+}
+
+TEST(ElementLoopRunnerTest, HexBodyAssembledByThreeRowOwnersIsBitwiseTheSerialBody) {
+  // The stiffness assembly splits A's rows into one node range per thread; with three, two
+  // boundaries cut the ball and their elements are computed by two parts each.
+  auto body = MakeHexBall(), reference = MakeHexBall();
+  ReversedRunner runner(3);
   ExpectSameSteps(*body, *reference, &runner);
   EXPECT_GT(runner.chunks_run, 0);
 }
