@@ -172,13 +172,18 @@ void DelassusColumns::BuildW(const IslandRows& rows, const std::vector<int>& bod
   if (num_fresh == 0) return;
   // Runs [start, end) of rows where a fresh column is nonzero (whole supernodes of the paths).
   const MatX& fresh = body.fresh_solved;
+  const int n = static_cast<int>(fresh.rows());
+  std::vector<unsigned char>& nonzero = body.row_is_nonzero;
+  nonzero.assign(n, 0);
+  for (int f = 0; f < num_fresh; ++f) {  // column by column: contiguous reads
+    const double* column = fresh.col(f).data();
+    for (int r = 0; r < n; ++r) nonzero[r] |= static_cast<unsigned char>(column[r] != 0.0);
+  }
   std::vector<int>& runs = body.nonzero_rows;
   runs.clear();
   int num_nonzero = 0;
-  for (int r = 0; r < static_cast<int>(fresh.rows()); ++r) {
-    bool nonzero = false;
-    for (int f = 0; f < num_fresh && !nonzero; ++f) nonzero = fresh(r, f) != 0.0;
-    if (!nonzero) continue;
+  for (int r = 0; r < n; ++r) {
+    if (!nonzero[r]) continue;
     if (!runs.empty() && runs.back() == r)
       runs.back() = r + 1;
     else

@@ -70,8 +70,9 @@ class DelassusColumns {
     mutable VecX impulse;           // Z_b lambda
     mutable VecX impulse_velocity;  // G^T Z_b lambda
     std::vector<int> nonzero_rows;  // runs (start, end) of rows where a fresh column is nonzero
-    MatX gathered, gathered_fresh;  // those rows of Y and of fresh_solved
-    MatX cross;                     // Z^T Z_fresh
+    std::vector<unsigned char> row_is_nonzero;  // (DOFs) scratch of BuildW's scan
+    MatX gathered, gathered_fresh;              // those rows of Y and of fresh_solved
+    MatX cross;                                 // Z^T Z_fresh
     std::vector<ColumnSource> next_sources;
     std::vector<int> to_solve;  // columns of `next` solved in `fresh`
   };
