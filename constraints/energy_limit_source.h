@@ -39,6 +39,9 @@ class EnergyLimitSource final : public BodyConstraintSource {
  private:
   // U_e / U_max,e of element e at x (0 for an unlimited element).
   double CalcElementRatio(const VecX& x, int e) const;
+  // True when element e's energy bound (ElementModel::CalcElementEnergyBound) at x is below
+  // `fraction` U_max,e: then U_e < fraction U_max,e too, without the polar decomposition.
+  bool IsSurelyBelow(const VecX& x, int e, double fraction) const;
   // U_e of element e at x (rotation recomputed from x) [J].
   double CalcElementEnergy(const VecX& x, int e) const;
   // Fills C, the element's nodes and J of the row of element e at x, R_e its rotation there.

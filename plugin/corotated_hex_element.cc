@@ -45,6 +45,7 @@ HexRestElement CalcHexRestElement(const HexNodes& X, const LameParameters& lame)
   }
   // K_ba = K_ab^T holds to rounding; exactly after this (CalcRotatedHexStiffnessBlocks uses it).
   rest.shared_stiffness = std::make_shared<const Mat24>(0.5 * (stiffness + stiffness.transpose()));
+  rest.stiffness_norm_bound = rest.stiffness().cwiseAbs().rowwise().sum().maxCoeff() * (1.0 + 1e-7);
   rest.center_gradients =
       CalcHexShapeGradients(Vec3::Zero()) * CalcHexJacobian(X, Vec3::Zero()).inverse();
   for (int t = 0; t < 2; ++t) rest.tet_rest_inverses[t] = TetEdges(X, t).inverse();
@@ -127,6 +128,24 @@ Vec24 CorotatedDisplacement(const HexRestElement& rest, const HexNodes& x, const
   return u;
 }
 }  // namespace
+
+double CalcCorotatedHexEnergyBound(const HexRestElement& rest, const HexNodes& x, const Mat3& G) {
+  if (!(G.determinant() > 0.0)) return HUGE_VAL;
+  // ||G - R||_2 = max_i |s_i - 1| <= max_i |s_i^2 - 1| <= ||G^T G - I||_F (s_i > 0).
+  const double rotation_gap = (G.transpose() * G - Mat3::Identity()).norm();
+  Vec3 xc = Vec3::Zero(), Xc = Vec3::Zero();
+  for (int a = 0; a < 8; ++a) {
+    xc += x[a] / 8.0;
+    Xc += rest.X[a] / 8.0;
+  }
+  double u_squared = 0.0;  // sum_a (bound on ||u_a||)^2
+  for (int a = 0; a < 8; ++a) {
+    const Vec3 X_a = rest.X[a] - Xc;
+    const double u_a = ((x[a] - xc) - G * X_a).norm() + rotation_gap * X_a.norm();
+    u_squared += u_a * u_a;
+  }
+  return 0.5 * rest.stiffness_norm_bound * u_squared;
+}
 
 double CalcCorotatedHexEnergy(const HexRestElement& rest, const HexNodes& x, const Mat3& R) {
   const Vec24 u = CorotatedDisplacement(rest, x, R);

@@ -44,6 +44,9 @@ struct HexRestElement {
   // equal (a lattice's cells: the step streams one K_e instead of 4.6 kB per element).
   std::shared_ptr<const Mat24> shared_stiffness;
   const Mat24& stiffness() const { return *shared_stiffness; }
+  // max_i sum_j |K_e,ij| (1 + 1e-7) >= lambda_max(K_e), also of a shared K_e (within 1e-9 of
+  // its own entrywise) [N/m].
+  double stiffness_norm_bound = 0.0;
 };
 
 // Local nodes (0-based) of the inscribed tets: {1,4,6,7} -> {0,3,5,6}, {2,3,5,8} -> {1,2,4,7}.
@@ -75,6 +78,11 @@ Mat3 CalcHexRotation(const HexRestElement& rest, const HexNodes& x, HexRotationM
 
 // Co-rotated strain at Gauss point q: eps_q = sym(R^T G_q) - I.
 Mat3 CalcHexGaussStrain(const HexRestElement& rest, const HexNodes& x, const Mat3& R, int q);
+
+// An upper bound on U without R, for R = polar(G) (docs/math.md §4.6): with u_a = R^T (x_a -
+// x_c) - (X_a - X_c), ||u_a|| <= ||(x_a - x_c) - G (X_a - X_c)|| + ||G^T G - I||_F ||X_a - X_c||
+// for det G > 0, and U <= 1/2 lambda_max(K_e) ||u||^2; +inf for det G <= 0 [J].
+double CalcCorotatedHexEnergyBound(const HexRestElement& rest, const HexNodes& x, const Mat3& G);
 
 // U = 1/2 (R^T x - X)^T K_e (R^T x - X) [J].
 double CalcCorotatedHexEnergy(const HexRestElement& rest, const HexNodes& x, const Mat3& R);

@@ -13,6 +13,15 @@ double CalcCorotatedTetEnergy(const TetRestElement& rest, const LameParameters& 
   return rest.volume * (lame.mu * eps.squaredNorm() + 0.5 * lame.lambda * tr * tr);
 }
 
+double CalcCorotatedTetEnergyBound(const TetRestElement& rest, const LameParameters& lame,
+                                   const Mat3& G) {
+  // sum_i (s_i - 1)^2 <= sum_i (s_i^2 - 1)^2 = ||G^T G - I||_F^2 for s_i > 0, and
+  // tr(S - I)^2 <= 3 ||S - I||_F^2 (docs/math.md §4.6).
+  if (!(G.determinant() > 0.0)) return HUGE_VAL;
+  const double strain = (G.transpose() * G - Mat3::Identity()).squaredNorm();
+  return rest.volume * (lame.mu + 1.5 * std::max(lame.lambda, 0.0)) * strain;
+}
+
 Mat3 CalcCorotatedStress(const LameParameters& lame, const Mat3& G, const Mat3& R) {
   const double tr = (R.transpose() * G).trace() - 3.0;
   return 2.0 * lame.mu * (G - R) + lame.lambda * tr * R;

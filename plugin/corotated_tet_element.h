@@ -24,6 +24,11 @@ struct LameParameters {
 double CalcCorotatedTetEnergy(const TetRestElement& rest, const LameParameters& lame, const Mat3& G,
                               const Mat3& R);
 
+// An upper bound on Psi without R (docs/math.md §4.6): for det G > 0,
+//   Psi <= V (mu + 3/2 max(lambda, 0)) ||G^T G - I||_F^2;  +inf for det G <= 0.
+double CalcCorotatedTetEnergyBound(const TetRestElement& rest, const LameParameters& lame,
+                                   const Mat3& G);
+
 // First Piola-Kirchhoff stress P = 2 mu (G - R) + lambda tr(R^T G - I) R [Pa].
 Mat3 CalcCorotatedStress(const LameParameters& lame, const Mat3& G, const Mat3& R);
 

@@ -75,6 +75,9 @@ class ElementModel {
   // --- One element e at body positions x (3N), its rotation R_e recomputed at x ---
   // U_e [J].
   virtual double CalcElementEnergy(int e, const VecX& x) const = 0;
+  // An upper bound on U_e without the polar decomposition (docs/math.md §4.6), to skip elements
+  // far below a limit; +inf for an inverted element [J].
+  virtual double CalcElementEnergyBound(int e, const VecX& x) const = 0;
   // Returns U_e [J] and sets forces[a] = f_e of node element_nodes(e)[a] [N] (R_e held).
   virtual double CalcElementForces(int e, const VecX& x, ElementVectors& forces) const = 0;
   // The same, and (f_K_f not null) *f_K_f = f_e^T K f_e with K = R_e K0_e R_e^T

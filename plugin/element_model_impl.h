@@ -54,6 +54,9 @@ class ElementModelImpl : public ElementModel {
   double CalcEnergy(const VecX& x) const final;
 
   double CalcElementEnergy(int e, const VecX& x) const final;
+  double CalcElementEnergyBound(int e, const VecX& x) const final {
+    return Traits::CalcEnergyBound(data_, e, GatherElement(x, e));
+  }
   double CalcElementForces(int e, const VecX& x, ElementVectors& forces) const final;
   double CalcElementForcesAndStiffnessAlong(int e, const VecX& x, ElementVectors& forces,
                                             double* f_K_f) const final;

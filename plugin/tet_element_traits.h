@@ -57,6 +57,11 @@ struct TetElementTraits {
   static Frame MakeFrame(const RestData& data, int e, const Nodes& x, const Mat3& R) {
     return {CalcTetDeformationGradient(data.rest.elements[e], x), R};
   }
+  // An upper bound on CalcEnergy's Psi without R (+inf for an inverted element).
+  static double CalcEnergyBound(const RestData& data, int e, const Nodes& x) {
+    const TetRestElement& rest = data.rest.elements[e];
+    return CalcCorotatedTetEnergyBound(rest, data.lame, CalcTetDeformationGradient(rest, x));
+  }
   // Psi = V [mu ||S - I||^2 + lambda/2 tr(S - I)^2], S = R^T G.
   static double CalcEnergy(const RestData& data, int e, const Nodes& /*x*/, const Frame& frame) {
     return CalcCorotatedTetEnergy(data.rest.elements[e], data.lame, frame.G, frame.R);

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
+#include <cmath>
 
 #include "plugin/box_tet_mesher.h"
 #include "plugin/signed_svd.h"
@@ -53,6 +54,29 @@ VecX Forces(const TetRestElement& rest, const VecX& q) {
   const auto x = Unflatten(q);
   const Mat3 G = CalcTetDeformationGradient(rest, x);
   return Flatten(CalcCorotatedTetForces(rest, kLame, G, CalcPolarRotation(G)));
+}
+
+TEST(CorotatedTetElementTest, EnergyBoundWithoutRotationHoldsAndIsTightAtSmallStrain) {
+  std::array<Vec3, 4> X;
+  const TetRestElement rest = MakeRest(X);
+  std::mt19937 rng(21);
+  for (int trial = 0; trial < 200; ++trial) {
+    const auto x = RandomState(rng, X, /*invert=*/trial % 10 == 9);
+    const Mat3 G = CalcTetDeformationGradient(rest, x);
+    const double U = CalcCorotatedTetEnergy(rest, kLame, G, CalcPolarRotation(G));
+    const double bound = CalcCorotatedTetEnergyBound(rest, kLame, G);
+    if (!(G.determinant() > 0.0)) {
+      EXPECT_EQ(bound, HUGE_VAL) << "trial " << trial << ": inverted";
+      continue;
+    }
+    EXPECT_GE(bound, U) << "trial " << trial;
+  }
+  // Rotated small uniaxial stretch e: U = V (mu + lambda/2) e^2, the bound 4 V (mu + 3/2 lambda)
+  // e^2 to first order: loose by a factor below 12, so elements far from a limit are skipped.
+  const Mat3 Q = testing::RandomRotation(rng);
+  const Mat3 G = Q * Vec3(1.001, 1.0, 1.0).asDiagonal();
+  const double U = CalcCorotatedTetEnergy(rest, kLame, G, CalcPolarRotation(G));
+  EXPECT_LT(CalcCorotatedTetEnergyBound(rest, kLame, G), 12.0 * U);
 }
 
 TEST(CorotatedTetElementTest, ForcesAreMinusEnergyGradient) {
