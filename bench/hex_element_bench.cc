@@ -48,31 +48,34 @@ const DenseKernels* KernelSet(int index) {
   return index == 0 ? &GenericDenseKernels() : Avx2DenseKernels();
 }
 
-void BM_HexKernelRotatedBlocks(benchmark::State& state) {
+// Times one pass of `kernel(kernels, input, element)` over the input's elements, in the set
+// state.range(0) selects (0 generic, 1 avx2).
+template <typename Kernel>
+void RunHexKernel(benchmark::State& state, Kernel kernel) {
   const DenseKernels* kernels = KernelSet(static_cast<int>(state.range(0)));
   if (kernels == nullptr) return state.SkipWithError("this CPU or build has no AVX2 set");
   const HexKernelInput& input = Input();
-  HexStiffnessBlocks blocks;
   for (auto _ : state)
-    for (const Mat3& R : input.rotations) {
-      kernels->rotate_hex_stiffness_blocks(input.rest.stiffness().data(), R.data(), 0.5,
-                                           blocks[0].data());
-      benchmark::DoNotOptimize(blocks);
-    }
+    for (int e = 0; e < kElementCount; ++e) kernel(*kernels, input, e);
   state.SetLabel(kernels->name);
 }
 
+void BM_HexKernelRotatedBlocks(benchmark::State& state) {
+  HexStiffnessBlocks blocks;
+  RunHexKernel(state, [&](const DenseKernels& kernels, const HexKernelInput& input, int e) {
+    kernels.rotate_hex_stiffness_blocks(input.rest.stiffness().data(), input.rotations[e].data(),
+                                        0.5, blocks[0].data());
+    benchmark::DoNotOptimize(blocks);
+  });
+}
+
 void BM_HexKernelStiffnessTimes(benchmark::State& state) {
-  const DenseKernels* kernels = KernelSet(static_cast<int>(state.range(0)));
-  if (kernels == nullptr) return state.SkipWithError("this CPU or build has no AVX2 set");
-  const HexKernelInput& input = Input();
   Vec24 Ku;
-  for (auto _ : state)
-    for (const Vec24& u : input.displacements) {
-      kernels->multiply_hex_stiffness(input.rest.stiffness().data(), u.data(), Ku.data());
-      benchmark::DoNotOptimize(Ku);
-    }
-  state.SetLabel(kernels->name);
+  RunHexKernel(state, [&](const DenseKernels& kernels, const HexKernelInput& input, int e) {
+    kernels.multiply_hex_stiffness(input.rest.stiffness().data(), input.displacements[e].data(),
+                                   Ku.data());
+    benchmark::DoNotOptimize(Ku);
+  });
 }
 
 BENCHMARK(BM_HexKernelRotatedBlocks)

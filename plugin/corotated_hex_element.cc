@@ -102,11 +102,15 @@ Mat3 CalcHexInscribedTetDeformationGradient(const HexRestElement& rest, const He
   return TetEdges(x, t) * rest.tet_rest_inverses[t];
 }
 
+Mat3 CalcHexRotationGradient(const HexRestElement& rest, const HexNodes& x,
+                             HexRotationMethod method) {
+  return method == HexRotationMethod::kCenterPolar
+             ? CalcHexCenterDeformationGradient(rest, x)
+             : CalcHexInscribedTetDeformationGradient(rest, x, 0);
+}
+
 Mat3 CalcHexRotation(const HexRestElement& rest, const HexNodes& x, HexRotationMethod method) {
-  const Mat3 G = method == HexRotationMethod::kCenterPolar
-                     ? CalcHexCenterDeformationGradient(rest, x)
-                     : CalcHexInscribedTetDeformationGradient(rest, x, 0);
-  return CalcPolarRotation(G);
+  return CalcPolarRotation(CalcHexRotationGradient(rest, x, method));
 }
 
 Mat3 CalcHexGaussStrain(const HexRestElement& rest, const HexNodes& x, const Mat3& R, int q) {
@@ -115,14 +119,17 @@ Mat3 CalcHexGaussStrain(const HexRestElement& rest, const HexNodes& x, const Mat
 }
 
 namespace {
+// sum_a x_a / 8, summed in node order (the same bits wherever it is taken).
+Vec3 CalcHexCentroid(const HexNodes& x) {
+  Vec3 c = Vec3::Zero();
+  for (int a = 0; a < 8; ++a) c += x[a] / 8.0;
+  return c;
+}
+
 // u = R^T x - X, node-major, taken relative to the centroids (K_e annihilates translations),
 // u_a = R^T (x_a - x_c) - (X_a - X_c), so far-from-origin elements keep full precision.
 Vec24 CorotatedDisplacement(const HexRestElement& rest, const HexNodes& x, const Mat3& R) {
-  Vec3 xc = Vec3::Zero(), Xc = Vec3::Zero();
-  for (int a = 0; a < 8; ++a) {
-    xc += x[a] / 8.0;
-    Xc += rest.X[a] / 8.0;
-  }
+  const Vec3 xc = CalcHexCentroid(x), Xc = CalcHexCentroid(rest.X);
   Vec24 u;
   for (int a = 0; a < 8; ++a) u.segment<3>(3 * a) = R.transpose() * (x[a] - xc) - (rest.X[a] - Xc);
   return u;
@@ -133,11 +140,7 @@ double CalcCorotatedHexEnergyBound(const HexRestElement& rest, const HexNodes& x
   if (!(G.determinant() > 0.0)) return HUGE_VAL;
   // ||G - R||_2 = max_i |s_i - 1| <= max_i |s_i^2 - 1| <= ||G^T G - I||_F (s_i > 0).
   const double rotation_gap = (G.transpose() * G - Mat3::Identity()).norm();
-  Vec3 xc = Vec3::Zero(), Xc = Vec3::Zero();
-  for (int a = 0; a < 8; ++a) {
-    xc += x[a] / 8.0;
-    Xc += rest.X[a] / 8.0;
-  }
+  const Vec3 xc = CalcHexCentroid(x), Xc = CalcHexCentroid(rest.X);
   double u_squared = 0.0;  // sum_a (bound on ||u_a||)^2
   for (int a = 0; a < 8; ++a) {
     const Vec3 X_a = rest.X[a] - Xc;

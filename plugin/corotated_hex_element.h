@@ -73,6 +73,10 @@ Mat3 CalcHexCenterDeformationGradient(const HexRestElement& rest, const HexNodes
 // Affine deformation gradient of inscribed tet t (0: {1,4,6,7}, 1: {2,3,5,8}).
 Mat3 CalcHexInscribedTetDeformationGradient(const HexRestElement& rest, const HexNodes& x, int t);
 
+// The deformation gradient whose polar factor is the element rotation: G(0) or G_1467.
+Mat3 CalcHexRotationGradient(const HexRestElement& rest, const HexNodes& x,
+                             HexRotationMethod method);
+
 // Element rotation: signed polar rotation of G(0) or of G_1467 (det R = +1 even when inverted).
 Mat3 CalcHexRotation(const HexRestElement& rest, const HexNodes& x, HexRotationMethod method);
 

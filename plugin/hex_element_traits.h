@@ -48,10 +48,8 @@ struct HexElementTraits {
   // An upper bound on CalcEnergy's U without R (+inf for an inverted element).
   static double CalcEnergyBound(const RestData& data, int e, const Nodes& x) {
     const HexRestElement& rest = data.elements[e];
-    const Mat3 G = data.rotation_method == HexRotationMethod::kCenterPolar
-                       ? CalcHexCenterDeformationGradient(rest, x)
-                       : CalcHexInscribedTetDeformationGradient(rest, x, 0);
-    return CalcCorotatedHexEnergyBound(rest, x, G);
+    return CalcCorotatedHexEnergyBound(rest, x,
+                                       CalcHexRotationGradient(rest, x, data.rotation_method));
   }
   // U = 1/2 (R^T x - X)^T K_e (R^T x - X).
   static double CalcEnergy(const RestData& data, int e, const Nodes& x, const Frame& frame) {
