@@ -2,8 +2,10 @@
 // on G^T G + Givens QR) against Eigen's JacobiSVD with full U and V plus the same sign fix
 // (docs/math.md §0.2), over one fixed set of 1024 gradients I + 0.1 X (X uniform in [-1, 1]^9;
 // every 8th one inverted by a negated column). Time per iteration is one pass over all 1024;
-// median of 5 repetitions, so the ratio of the two medians is measured in one run.
-//   taut_bench --benchmark_filter='BM_SignedSvd|BM_EigenJacobiSvd'
+// median of 5 repetitions, so the ratio of the two medians is measured in one run. The element
+// rotation on the same set: CalcPolarRotation (plugin/polar_rotation.h, Newton's iteration; the
+// inverted eighth falls back to the SVD) against U V^T of CalcSignedSvd.
+//   taut_bench --benchmark_filter='BM_SignedSvd|BM_EigenJacobiSvd|BM_PolarRotation'
 #include <benchmark/benchmark.h>
 
 #include <Eigen/LU>
@@ -11,6 +13,7 @@
 #include <random>
 #include <vector>
 
+#include "plugin/polar_rotation.h"
 #include "plugin/signed_svd.h"
 
 namespace taut {
@@ -50,13 +53,19 @@ SignedSvd EigenSignedSvd(const Mat3& G) {
   return out;
 }
 
-template <SignedSvd (*Decompose)(const Mat3&)>
+// The element rotation as it was computed before Newton's iteration: U V^T of the signed SVD.
+Mat3 PolarRotationBySvd(const Mat3& G) {
+  const SignedSvd svd = CalcSignedSvd(G);
+  return svd.U * svd.V.transpose();
+}
+
+template <auto Decompose>
 void RunSvd(benchmark::State& state) {
   const std::vector<Mat3>& gradients = Gradients();
   for (auto _ : state) {
     for (const Mat3& G : gradients) {
-      SignedSvd svd = Decompose(G);
-      benchmark::DoNotOptimize(svd);
+      auto result = Decompose(G);
+      benchmark::DoNotOptimize(result);
     }
   }
   state.SetItemsProcessed(state.iterations() * kGradientCount);
@@ -64,9 +73,19 @@ void RunSvd(benchmark::State& state) {
 
 void BM_SignedSvd(benchmark::State& state) { RunSvd<CalcSignedSvd>(state); }
 void BM_EigenJacobiSvd(benchmark::State& state) { RunSvd<EigenSignedSvd>(state); }
+void BM_PolarRotation(benchmark::State& state) { RunSvd<CalcPolarRotation>(state); }
+void BM_PolarRotationBySvd(benchmark::State& state) { RunSvd<PolarRotationBySvd>(state); }
 
 BENCHMARK(BM_SignedSvd)->Unit(benchmark::kMicrosecond)->Repetitions(5)->ReportAggregatesOnly(true);
 BENCHMARK(BM_EigenJacobiSvd)
+    ->Unit(benchmark::kMicrosecond)
+    ->Repetitions(5)
+    ->ReportAggregatesOnly(true);
+BENCHMARK(BM_PolarRotation)
+    ->Unit(benchmark::kMicrosecond)
+    ->Repetitions(5)
+    ->ReportAggregatesOnly(true);
+BENCHMARK(BM_PolarRotationBySvd)
     ->Unit(benchmark::kMicrosecond)
     ->Repetitions(5)
     ->ReportAggregatesOnly(true);

@@ -1,6 +1,6 @@
 #include "constraints/energy_limit_rows.h"
 
-#include "plugin/signed_svd.h"
+#include "plugin/polar_rotation.h"
 
 namespace taut {
 

@@ -98,7 +98,8 @@ void PrimalSolver::CalcPenalties(double h, const std::vector<IslandBody*>& bodie
   if (rho_kept_) rows_.OverwriteByKey(kept_rho_, rho_);
 }
 
-void PrimalSolver::GrowStalledPenalties(const PrimalSettings& settings, double tolerance) {
+void PrimalSolver::GrowStalledPenalties(const PrimalSettings& settings, double tolerance,
+                                        int iteration) {
   // A limit row still violated by more than the tolerance whose violation fell by less than half
   // over the last multiplier iteration has its rho multiplied by penalty_growth, up to
   // max_penalty_growth times its Delassus value (docs/math.md §5.8, penalty growth). Once the
@@ -107,6 +108,9 @@ void PrimalSolver::GrowStalledPenalties(const PrimalSettings& settings, double t
   // falls by only rho C / h per iteration. rho_ holds the kept, already grown, penalties of the
   // last multiplier iteration.
   const bool count_slack_push = settings.grow_on_slack_push && violation_ <= tolerance;
+  const double cap = iteration >= settings.late_growth_iteration
+                         ? std::max(settings.max_penalty_growth, settings.late_max_penalty_growth)
+                         : settings.max_penalty_growth;
   const int m = rows_.size();
   last_.setConstant(m, -1.0);
   growth_.setOnes(m);
@@ -120,8 +124,7 @@ void PrimalSolver::GrowStalledPenalties(const PrimalSettings& settings, double t
         count_slack_push && rows_[c].full_curvature && lambda_bar_[c] > 0.0 && rows_[c].C > 0.0;
     const double violation = pushing_while_slack ? rows_[c].C : std::max(0.0, -rows_[c].C);
     if (violation > tolerance && last_[c] >= 0.0 && violation > 0.5 * last_[c]) {
-      const double next =
-          std::min(growth_[c] * settings.penalty_growth, settings.max_penalty_growth);
+      const double next = std::min(growth_[c] * settings.penalty_growth, cap);
       rho_[c] *= next / growth_[c];
       growth_[c] = next;
     }
@@ -869,7 +872,7 @@ void PrimalSolver::Solve(double h, const std::vector<IslandBody*>& bodies,
     }
     // Minimize Phi for this lambda_bar and rho, then the multiplier update
     // lambda_bar <- Proj(y(v)).
-    if (primal.penalty_growth > 1.0) GrowStalledPenalties(primal, settings.violation_tolerance);
+    if (primal.penalty_growth > 1.0) GrowStalledPenalties(primal, settings.violation_tolerance, k);
     KeepPenalties();
     for (int it = 0; it < primal.max_newton_iterations; ++it) {
       const double violation_before = violation_;

@@ -85,8 +85,9 @@ class PrimalSolver {
   // (docs/math.md §5.8, penalties).
   void KeepPenalties();
   // Stage: rho of limit rows whose violation stalls over a multiplier iteration grows
-  // (PrimalSettings::penalty_growth), applied to the kept penalties before KeepPenalties.
-  void GrowStalledPenalties(const PrimalSettings& settings, double tolerance);
+  // (PrimalSettings::penalty_growth, capped by the late cap from late_growth_iteration on), applied
+  // to the kept penalties before KeepPenalties; `iteration` is the multiplier iteration k.
+  void GrowStalledPenalties(const PrimalSettings& settings, double tolerance, int iteration);
   // g0_c with g_c(v + dv) = g0_c + J_c (v + dv) at the collected rows, and which rows H can hold
   // on the bodies' patterns.
   void LinearizeRows(double h, const std::vector<IslandBody*>& bodies);

@@ -40,6 +40,8 @@ void ValidatePrimalSettings(const PrimalSettings& p) {
   DemandPositive("primal.penalty_scale", p.penalty_scale);
   DemandAtLeast("primal.penalty_growth", p.penalty_growth, 1.0);
   DemandAtLeast("primal.max_penalty_growth", p.max_penalty_growth, 1.0);
+  DemandCount("primal.late_growth_iteration", p.late_growth_iteration, 0);
+  DemandAtLeast("primal.late_max_penalty_growth", p.late_max_penalty_growth, 1.0);
   DemandAtLeast("primal.newton_tolerance", p.newton_tolerance, 0.0);
   DemandAtLeast("primal.newton_row_move_fraction", p.newton_row_move_fraction, 0.0);
   DemandAtLeast("primal.newton_stop_distance_factor", p.newton_stop_distance_factor, 0.0);

@@ -25,6 +25,12 @@ struct PrimalSettings {
   // iteration gets penalty_growth times its rho, up to max_penalty_growth times (1 = off).
   double penalty_growth = 3.0;
   double max_penalty_growth = 10.0;
+  // From multiplier iteration late_growth_iteration on, the cap is late_max_penalty_growth: a step
+  // that has not converged by then has rows whose Newton model holds only near the iterate (frame
+  // derivatives near repeated stretches, docs/math.md §5.8, late growth); steps converging
+  // earlier are unchanged.
+  int late_growth_iteration = 10;
+  double late_max_penalty_growth = 1000.0;
   // ... and, once the iterate is feasible, a row with full curvature that pushes while slack by
   // more than the tolerance, by its complementarity residual C (docs/math.md §5.8).
   bool grow_on_slack_push = true;

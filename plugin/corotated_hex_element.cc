@@ -6,7 +6,7 @@
 #include <unordered_map>
 
 #include "plugin/dense_kernels.h"
-#include "plugin/signed_svd.h"
+#include "plugin/polar_rotation.h"
 
 namespace taut {
 

@@ -253,9 +253,4 @@ SignedSvd CalcSignedSvd(const Mat3& G) {
   return {U, s, V};
 }
 
-Mat3 CalcPolarRotation(const Mat3& G) {
-  const SignedSvd svd = CalcSignedSvd(G);
-  return svd.U * svd.V.transpose();
-}
-
 }  // namespace taut

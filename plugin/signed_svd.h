@@ -27,8 +27,4 @@ struct SignedSvd {
 // sliver's s_3 = 1e-6 s_1 to ~1e-10 relative.
 SignedSvd CalcSignedSvd(const Mat3& G);
 
-// Rotation of the polar decomposition G = R S taken from the signed SVD: R = U V^T (det R = +1,
-// also for inverted G).
-Mat3 CalcPolarRotation(const Mat3& G);
-
 }  // namespace taut

@@ -8,7 +8,7 @@
 #include "plugin/contact_surface.h"
 #include "plugin/corotated_tet_element.h"
 #include "plugin/material.h"
-#include "plugin/signed_svd.h"
+#include "plugin/polar_rotation.h"
 
 namespace taut {
 

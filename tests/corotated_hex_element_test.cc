@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "plugin/material.h"
-#include "plugin/signed_svd.h"
+#include "plugin/polar_rotation.h"
 #include "tests/test_utils.h"
 
 namespace taut {

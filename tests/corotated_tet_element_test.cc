@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "plugin/box_tet_mesher.h"
-#include "plugin/signed_svd.h"
+#include "plugin/polar_rotation.h"
 #include "plugin/tet_element_model.h"
 #include "plugin/tet_element_traits.h"
 #include "tests/test_utils.h"

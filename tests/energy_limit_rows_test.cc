@@ -5,7 +5,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "plugin/material.h"
-#include "plugin/signed_svd.h"
+#include "plugin/polar_rotation.h"
 #include "tests/test_utils.h"
 
 namespace taut {

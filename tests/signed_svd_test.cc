@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <random>
 
+#include "plugin/polar_rotation.h"
 #include "tests/test_utils.h"
 
 namespace taut {
