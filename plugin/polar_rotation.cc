@@ -7,8 +7,8 @@
 namespace taut {
 namespace {
 
-// Newton's polar iteration gives up after this many steps (the SVD answers instead). From
-// ||X_0||_F-scaled G it converges in 3-6 steps down to s_3 / s_1 ~ 1e-8 (measured).
+// Newton's polar iteration gives up after this many steps (the SVD answers instead). With the
+// Frobenius scaling it converges in 3-6 steps down to s_3 / s_1 ~ 1e-8 (measured).
 constexpr int kMaxNewtonSteps = 10;
 // Stop when ||X_{k+1} - X_k||_F^2 <= this: the step is about the distance to the limit, so the
 // next distance is about its square over 2, ~5e-17.
