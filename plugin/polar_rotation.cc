@@ -63,8 +63,7 @@ Mat3 CalcPolarRotation(const Mat3& G) {
     if (step < 0.0) break;  // near singular, inverted or not finite: the signed SVD's rotation
     if (step <= kStepSquaredTolerance) return X;
   }
-  const SignedSvd svd = CalcSignedSvd(G);
-  return svd.U * svd.V.transpose();
+  return CalcPolarRotationBySvd(G);
 }
 
 }  // namespace taut

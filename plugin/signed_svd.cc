@@ -253,4 +253,9 @@ SignedSvd CalcSignedSvd(const Mat3& G) {
   return {U, s, V};
 }
 
+Mat3 CalcPolarRotationBySvd(const Mat3& G) {
+  const SignedSvd svd = CalcSignedSvd(G);
+  return svd.U * svd.V.transpose();
+}
+
 }  // namespace taut

@@ -27,4 +27,8 @@ struct SignedSvd {
 // sliver's s_3 = 1e-6 s_1 to ~1e-10 relative.
 SignedSvd CalcSignedSvd(const Mat3& G);
 
+// R = U V^T of the signed SVD: the rotation of G's polar decomposition, a proper rotation also
+// for inverted and singular G (plugin/polar_rotation.h takes it faster where det G > 0).
+Mat3 CalcPolarRotationBySvd(const Mat3& G);
+
 }  // namespace taut
