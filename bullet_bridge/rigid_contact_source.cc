@@ -149,14 +149,14 @@ void RigidContactSource::AppendContactRows(const IslandIterate& iterate, const P
                                            double gap, const Vec3& n, const Vec3& q,
                                            const Vec3& com,
                                            std::vector<ConstraintRow>& rows) const {
-  // Normal row C = gap, J = w_k n on the point's nodes; then the two tangents (friction on the
-  // Coulomb disk). A dynamic partner's surface point q moves with v + w x (q - com), so its side
-  // is J_lin = -d, J_ang = -(q - com) x d for each direction d.
+  // Normal row C = gap, J = w_k n on the point's nodes; then, when mu > 0, the two tangents
+  // (friction on the Coulomb disk). A dynamic partner's surface point q moves with v + w x (q -
+  // com), so its side is J_lin = -d, J_ang = -(q - com) x d for each direction d.
   Vec3 d[3];
   d[0] = n;
   CalcContactTangents(n, d[1], d[2]);
   const size_t normal = rows.size();
-  for (int k = 0; k < 3; ++k) {
+  for (int k = 0; k < CountContactRows(partner.mu); ++k) {
     ConstraintRow& row = rows.emplace_back();
     const std::uint64_t key =
         key_.Pack(index, partner.outside_world, partner.object_id, row_offset + k);

@@ -80,7 +80,7 @@ int RigidManifoldSource::AppendIslandRows(const IslandIterate& iterate,
     const int ib = p.b != nullptr ? iterate.IndexOf(p.b) : -1;
     const double c = CalcNormalC(iterate, p);
     const Vec3 d[3] = {p.normal, p.tangent[0], p.tangent[1]};
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < CountContactRows(p.friction); ++k) {
       ConstraintRow& row = rows.emplace_back();
       row.key = p.keys[k];
       row.C = k == 0 ? c : 0.0;

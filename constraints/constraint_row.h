@@ -74,6 +74,12 @@ struct ConstraintRow {
   }
 };
 
+// Rows a contact emits: its normal row, then two friction rows only when mu > 0. A frictionless
+// contact's tangent multipliers are held at 0 by the Coulomb disk |lambda_t| <= 0, so its
+// tangent rows carry no force: they would only add rows to the QP and make it a mixed
+// complementarity problem (no active-set polish on the dual path; docs/math.md §5.5).
+inline int CountContactRows(double mu) { return mu > 0.0 ? 3 : 1; }
+
 // Two unit tangents t1, t2 completing the unit normal n to a right-handed frame (n, t1, t2 = n x
 // t1): the friction directions of a contact (docs/math.md §5.5).
 inline void CalcContactTangents(const Vec3& n, Vec3& t1, Vec3& t2) {

@@ -149,7 +149,7 @@ int DeformableContactSource::AppendIslandRows(const IslandIterate& iterate,
     Vec3 d[3];
     d[0] = hit.normal;
     CalcContactTangents(hit.normal, d[1], d[2]);
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < CountContactRows(friction_); ++k) {
       ConstraintRow& row = rows.emplace_back();
       row.key = key_.Pack(hit.direction, hit.point, hit.triangle, k);
       row.C = k == 0 ? hit.gap : 0.0;

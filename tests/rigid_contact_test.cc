@@ -83,6 +83,30 @@ TEST(RigidContactTest, FrictionSticksBelowTheConeAndSlidesAboveIt) {
   EXPECT_GT(slippery.MinZ(), -2e-3);
 }
 
+TEST(RigidContactTest, FrictionlessContactSlidesFreelyOnNormalRowsAlone) {
+  // mu = 0 on the 30 degree incline: the block slides as if no friction rows existed
+  // (a = g sin 30 = 4.9 m/s^2 -> 0.61 m in 0.5 s), and each contact has its normal row only.
+  const double theta = M_PI / 6.0;
+  const btVector3 gravity(9.81 * std::sin(theta), 0, -9.81 * std::cos(theta));
+  CubeOnGround frictionless(0.0, 0.0005, gravity), rough(0.1, 0.0005, gravity);
+  const double x0 = frictionless.MeanX();
+  frictionless.Run(120);
+  rough.Run(120);
+  const double slide = frictionless.MeanX() - x0;
+  const double expected = 0.5 * 9.81 * std::sin(theta) * 0.25;
+  const int normal_rows = frictionless.holder.world.last_step_stats().rows_contact;
+  const int rough_rows = rough.holder.world.last_step_stats().rows_contact;
+  std::printf(
+      "incline 30 deg, mu = 0: moves %.4f m in 0.5 s (rigid block %.4f m), %d rows; "
+      "mu = 0.1: %d rows\n",
+      slide, expected, normal_rows, rough_rows);
+  EXPECT_NEAR(slide, expected, 0.25 * expected);
+  EXPECT_GT(slide, rough.MeanX() - x0);
+  EXPECT_GT(normal_rows, 0);
+  EXPECT_EQ(rough_rows, 3 * normal_rows);
+  EXPECT_GT(frictionless.MinZ(), -2e-3);
+}
+
 }  // namespace
 }  // namespace taut
 

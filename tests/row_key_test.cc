@@ -262,6 +262,7 @@ TEST(RowKeyTest, ManifoldObjectsWhoseIdsDifferBy2To20GetDifferentKeys) {
   for (btCollisionObject* a : {&first, &aliased}) {
     btPersistentManifold manifold(a, &other, 0, 0.02, 0.02);
     btManifoldPoint point(btVector3(0, 0, 0), btVector3(0, 0, 0), btVector3(0, 0, 1), -0.001);
+    point.m_combinedFriction = 0.5;  // a normal and two friction rows per point
     manifold.addManifoldPoint(point);
     source.AddManifold(manifold, nullptr, nullptr, info);
   }
