@@ -14,7 +14,6 @@ double PolishActiveSet(const MatX& W, const VecX& q, const std::vector<PgsRow>& 
   for (const PgsRow& row : rows)
     if (row.kind != RowKind::kUnilateral) return residual;
   if (m == 0) return residual;
-  const double reg = settings.regularization * W.diagonal().maxCoeff();
   std::vector<int> active;
   VecX candidate(m), trial(m);
   // Objective of the unilateral LCP as a bound-constrained QP: f = 1/2 l^T W l + q^T l.
@@ -33,7 +32,10 @@ double PolishActiveSet(const MatX& W, const VecX& q, const std::vector<PgsRow>& 
     for (int a = 0; a < k; ++a) {
       rhs[a] = -w[active[a]];
       for (int b = 0; b < k; ++b) W_FF(a, b) = W(active[a], active[b]);
-      W_FF(a, a) += reg;
+      // Each row regularized relative to its own W_cc: rows of one island differ in scale by up to
+      // 1e9 (the finger: contact rows in distance units, strain rows of stiff and soft elements),
+      // and a shift relative to the largest W_cc swamped the small rows' block.
+      W_FF(a, a) += settings.regularization * W(active[a], active[a]);
     }
     // Newton direction on the free set, then a projected backtracking search on f
     // (bound-constrained projected Newton): f never increases, so the refinement cannot diverge.
