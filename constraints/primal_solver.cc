@@ -95,6 +95,7 @@ void PrimalSolver::CalcPenalties(double h, const std::vector<IslandBody*>& bodie
   }
   // Within a multiplier iteration limit rows keep the rho they started it with: rho from a trial
   // point's J would make Phi's slope along d disagree with grad Phi . d.
+  fresh_rho_ = rho_;
   if (rho_kept_) rows_.OverwriteByKey(kept_rho_, rho_);
 }
 
@@ -133,6 +134,20 @@ void PrimalSolver::GrowStalledPenalties(const PrimalSettings& settings, double t
   }
   std::sort(last_violation_.begin(), last_violation_.end());
   std::sort(kept_growth_.begin(), kept_growth_.end());
+}
+
+bool PrimalSolver::CapKeptPenalties(const PrimalSettings& settings) {
+  const double cap = std::max(settings.max_penalty_growth, settings.late_max_penalty_growth);
+  bool lowered = false;
+  for (int c = 0; c < rows_.size(); ++c) {
+    const double bound = cap * fresh_rho_[c];
+    if (rho_[c] > bound) {
+      rho_[c] = bound;
+      lowered = true;
+    }
+  }
+  if (lowered) KeepPenalties();
+  return lowered;
 }
 
 void PrimalSolver::KeepPenalties() {
@@ -626,7 +641,20 @@ bool PrimalSolver::TakeNewtonStep(double h, const std::vector<IslandBody*>& bodi
   else
     curvature_.Clear();
   ChooseFactorReuse(bodies, primal);
-  stats.newton_factorizations += AssembleNewtonMatrices(bodies, primal.clamp_curvature_on_failure);
+  try {
+    stats.newton_factorizations +=
+        AssembleNewtonMatrices(bodies, primal.clamp_curvature_on_failure);
+  } catch (const SimulationError&) {
+    // H = A + sum rho J^T D J without curvature did not factor: a kept rho was set for a J that
+    // has grown since (frame terms near repeated stretches grow like 1 / (s_i - s_j)), and
+    // rho J^T J outgrew A by 1e16 (the orthogonal column with 20 PGS sweeps per QP). Such rows
+    // keep at most the largest growth over their Delassus value at this J, and the step is taken
+    // with those penalties (docs/math.md §5.8, penalties).
+    if (!CapKeptPenalties(primal)) throw;
+    CalcProjectedMultipliers();
+    CalcGradient(bodies);
+    stats.newton_factorizations += AssembleNewtonMatrices(bodies, false);
+  }
   stats.pcg_iterations += SolveNewtonStep(bodies, primal);
   stats.newton_iterations++;
 

@@ -84,6 +84,10 @@ class PrimalSolver {
   // multiplier iteration, so grad Phi is the gradient of the Phi the line search measures
   // (docs/math.md §5.8, penalties).
   void KeepPenalties();
+  // Lowers every rho above max(max_penalty_growth, late_max_penalty_growth) times the row's
+  // Delassus value at its current J to that bound and keeps the result (KeepPenalties); returns
+  // whether any rho changed. For a Newton matrix that does not factor without curvature.
+  bool CapKeptPenalties(const PrimalSettings& settings);
   // Stage: rho of limit rows whose violation stalls over a multiplier iteration grows
   // (PrimalSettings::penalty_growth, capped by the late cap from late_growth_iteration on), applied
   // to the kept penalties before KeepPenalties; `iteration` is the multiplier iteration k.
@@ -161,6 +165,7 @@ class PrimalSolver {
   VecX newton_reported_;       // ... of the Newton loop's certificate
   VecX rho_, g0_, jv_, s_;     // penalties, g_c(v) = g0 + J v, J v, J d
   KeyedMultipliers kept_rho_;  // limit rows' rho of this multiplier iteration by key
+  VecX fresh_rho_;             // rho at the rows' current J, before the kept values (CalcPenalties)
   bool rho_kept_ = false;
   KeyedMultipliers last_violation_;  // limit rows' stall residual at the last multiplier iteration
   KeyedMultipliers kept_growth_;     // limit rows' rho growth (> 1) of this step by key
