@@ -63,11 +63,19 @@ TEST(RigidContactTest, DroppedCubeComesToRestOnTheGroundWithoutSinkingIn) {
   EXPECT_LT(scene.cube->v().norm() / std::sqrt(scene.cube->num_nodes()), 0.05);  // at rest
 }
 
+// Gravity tilted by 30 degrees = a 30 degree incline (tan 30 = 0.577) down +x.
+constexpr double kInclineAngle = M_PI / 6.0;
+// A cube with friction coefficient mu resting 0.5 mm above that incline.
+struct CubeOnIncline : CubeOnGround {
+  explicit CubeOnIncline(double mu)
+      : CubeOnGround(
+            mu, 0.0005,
+            btVector3(9.81 * std::sin(kInclineAngle), 0, -9.81 * std::cos(kInclineAngle))) {}
+};
+
 TEST(RigidContactTest, FrictionSticksBelowTheConeAndSlidesAboveIt) {
-  // Gravity tilted by 30 degrees = a 30 degree incline: tan 30 = 0.577.
-  const double theta = M_PI / 6.0;
-  const btVector3 gravity(9.81 * std::sin(theta), 0, -9.81 * std::cos(theta));
-  CubeOnGround sticky(1.0, 0.0005, gravity), slippery(0.1, 0.0005, gravity);
+  const double theta = kInclineAngle;
+  CubeOnIncline sticky(1.0), slippery(0.1);
   const double x0 = sticky.MeanX();
   sticky.Run(120);
   slippery.Run(120);
@@ -86,9 +94,8 @@ TEST(RigidContactTest, FrictionSticksBelowTheConeAndSlidesAboveIt) {
 TEST(RigidContactTest, FrictionlessContactSlidesFreelyOnNormalRowsAlone) {
   // mu = 0 on the 30 degree incline: the block slides as if no friction rows existed
   // (a = g sin 30 = 4.9 m/s^2 -> 0.61 m in 0.5 s), and each contact has its normal row only.
-  const double theta = M_PI / 6.0;
-  const btVector3 gravity(9.81 * std::sin(theta), 0, -9.81 * std::cos(theta));
-  CubeOnGround frictionless(0.0, 0.0005, gravity), rough(0.1, 0.0005, gravity);
+  const double theta = kInclineAngle;
+  CubeOnIncline frictionless(0.0), rough(0.1);
   const double x0 = frictionless.MeanX();
   frictionless.Run(120);
   rough.Run(120);
